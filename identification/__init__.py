@@ -1,0 +1,1 @@
+"""Material identification: tensile test curves of colon tissue -> Mooney-Rivlin parameters."""
