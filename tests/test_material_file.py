@@ -1,0 +1,141 @@
+"""Reading the Mooney-Rivlin material file, and every way it can be wrong."""
+
+import json
+
+import numpy as np
+import pytest
+
+from colonsim.errors import ColonsimError
+from insertion.material import REFERENCE_MATERIAL_PATH, MooneyRivlin, load_material
+
+
+def write(tmp_path, data, name="mat.json"):
+    path = tmp_path / name
+    path.write_text(data if isinstance(data, str) else json.dumps(data))
+    return path
+
+
+def good(**overrides):
+    data = {"law": "mooney_rivlin_3", "units": "Pa",
+            "parameters": {"C10": 652.01, "C01": 42835.25, "C11": 219120.3}}
+    data.update(overrides)
+    return data
+
+
+def test_reference_file_holds_source_parameters():
+    mat = load_material(REFERENCE_MATERIAL_PATH)
+    assert (mat.C10, mat.C01, mat.C11) == (652.01, 42835.25, 219120.3)
+    assert mat.mu0 == pytest.approx(2 * (652.01 + 42835.25), rel=1e-15)
+    assert mat.E0 == pytest.approx(6 * (652.01 + 42835.25), rel=1e-15)
+
+
+def test_reference_path_is_the_repo_data_file():
+    assert REFERENCE_MATERIAL_PATH.name == "material_reference.json"
+    assert REFERENCE_MATERIAL_PATH.parent.name == "data"
+    assert REFERENCE_MATERIAL_PATH.is_file()
+
+
+def test_load_accepts_str_path(tmp_path):
+    mat = load_material(str(write(tmp_path, good())))
+    assert isinstance(mat, MooneyRivlin)
+
+
+def test_material_is_frozen():
+    mat = MooneyRivlin(1.0, 2.0, 3.0)
+    with pytest.raises(AttributeError):
+        mat.C10 = 5.0
+
+
+def test_uniaxial_stress_matches_numerical_derivative_of_energy():
+    # Incompressible uniaxial: P = dW/dl with I1 = l^2 + 2/l, I2 = 2l + 1/l^2.
+    mat = MooneyRivlin(652.01, 42835.25, 219120.3)
+
+    def w(lam):
+        i1 = lam**2 + 2 / lam
+        i2 = 2 * lam + 1 / lam**2
+        return mat.C10 * (i1 - 3) + mat.C01 * (i2 - 3) + mat.C11 * (i1 - 3) * (i2 - 3)
+
+    for lam in (0.8, 1.1, 1.6):
+        h = 1e-6
+        # central difference error ~h^2 W''' ~ 1e-12 relative; rounding ~1e-16 W/h ~ 1e-10
+        assert mat.uniaxial_nominal_stress(lam) == pytest.approx(
+            (w(lam + h) - w(lam - h)) / (2 * h), rel=1e-7)
+    assert mat.uniaxial_nominal_stress(1.0) == 0.0
+    # small-strain slope is E0
+    eps = 1e-6
+    assert mat.uniaxial_nominal_stress(1 + eps) / eps == pytest.approx(mat.E0, rel=1e-4)
+
+
+def test_missing_file(tmp_path):
+    with pytest.raises(ColonsimError, match="not found"):
+        load_material(tmp_path / "nope.json")
+
+
+def test_bad_json(tmp_path):
+    with pytest.raises(ColonsimError, match="not valid JSON"):
+        load_material(write(tmp_path, "{law: mooney"))
+
+
+def test_not_an_object(tmp_path):
+    with pytest.raises(ColonsimError, match="JSON object"):
+        load_material(write(tmp_path, "[1, 2, 3]"))
+
+
+def test_unknown_law(tmp_path):
+    with pytest.raises(ColonsimError, match="law 'yeoh'"):
+        load_material(write(tmp_path, good(law="yeoh")))
+
+
+def test_missing_law(tmp_path):
+    data = good()
+    del data["law"]
+    with pytest.raises(ColonsimError, match="law None"):
+        load_material(write(tmp_path, data))
+
+
+def test_wrong_units(tmp_path):
+    with pytest.raises(ColonsimError, match="units 'MPa'"):
+        load_material(write(tmp_path, good(units="MPa")))
+
+
+def test_missing_parameters_object(tmp_path):
+    data = good()
+    del data["parameters"]
+    with pytest.raises(ColonsimError, match="'parameters'"):
+        load_material(write(tmp_path, data))
+
+
+def test_missing_parameter(tmp_path):
+    with pytest.raises(ColonsimError, match="misses parameter.*C11"):
+        load_material(write(tmp_path, good(parameters={"C10": 1.0, "C01": 2.0})))
+
+
+@pytest.mark.parametrize("name", ["C10", "C01", "C11"])
+def test_negative_parameter(tmp_path, name):
+    params = {"C10": 1.0, "C01": 2.0, "C11": 3.0}
+    params[name] = -1.0
+    with pytest.raises(ColonsimError, match=f"{name} = -1.0"):
+        load_material(write(tmp_path, good(parameters=params)))
+
+
+@pytest.mark.parametrize("value", ["abc", None, True, [1.0]])
+def test_non_numeric_parameter(tmp_path, value):
+    with pytest.raises(ColonsimError, match="must be a number"):
+        load_material(write(tmp_path, good(parameters={"C10": value, "C01": 2.0, "C11": 3.0})))
+
+
+def test_non_finite_parameter():
+    with pytest.raises(ColonsimError, match="finite"):
+        MooneyRivlin(np.inf, 1.0, 1.0)
+    with pytest.raises(ColonsimError, match="finite"):
+        MooneyRivlin(np.nan, 1.0, 1.0)
+
+
+def test_zero_small_strain_stiffness(tmp_path):
+    with pytest.raises(ColonsimError, match="C10 \\+ C01"):
+        load_material(write(tmp_path, good(parameters={"C10": 0.0, "C01": 0.0, "C11": 3.0})))
+
+
+def test_integer_parameters_become_floats(tmp_path):
+    mat = load_material(write(tmp_path, good(parameters={"C10": 1, "C01": 2, "C11": 0})))
+    assert isinstance(mat.C10, float) and mat.E0 == 18.0
