@@ -1,0 +1,569 @@
+"""Explicit central-difference integration of several bodies with contact and constraints.
+
+Scheme (lumped masses, staggered velocities, mass-proportional damping alpha averaged over the
+step so that it never limits the time step)::
+
+    v_{n+1/2} = ((1 - h) v_{n-1/2} + dt f_n / m) / (1 + h),   h = alpha dt / 2
+    constraints overwrite v_{n+1/2} on their nodes (the change is the reaction impulse)
+    x_{n+1} = x_n + dt v_{n+1/2}
+
+Energy accounting per body: the work of every force family (internal, contact, loads, damping,
+constraint reactions) is summed as dt F_n . (v_{n-1/2} + v_{n+1/2}) / 2, which makes the kinetic
+energy balance exact; kinetic energy is reported at the mid-velocity, internal (strain) energy from
+the body at x_n. Contact penalty energy and contact dissipation (damping and friction) are kept by
+the contact objects.
+
+Divergence guard: a non-finite state, or mechanical energy growing beyond ``energy_growth_limit``
+times (initial energy + absolute work put in), stops the run with a :class:`ColonsimError` naming
+the time, the step and the remedy.
+"""
+
+import math
+
+import numba
+import numpy as np
+
+from colonsim.errors import ColonsimError
+
+# ---------------------------------------------------------------------------------------------
+# Kernels
+# ---------------------------------------------------------------------------------------------
+
+
+@numba.njit(parallel=True, cache=True)
+def velocity_kernel(v, f_int, f_con, f_ext, mass, fixed, alpha, dt, v_new, f_damp, reaction):
+    """Damped velocity update into ``v_new``; fixed nodes get zero velocity and their reaction."""
+    n = v.shape[0]
+    h = 0.5 * alpha * dt
+    for i in numba.prange(n):
+        m = mass[i]
+        for k in range(3):
+            ftot = f_int[i, k] + f_con[i, k] + f_ext[i, k]
+            vf = ((1.0 - h) * v[i, k] + dt * ftot / m) / (1.0 + h)
+            f_damp[i, k] = -alpha * m * 0.5 * (v[i, k] + vf)
+            if fixed[i]:
+                v_new[i, k] = 0.0
+                reaction[i, k] = -m * vf / dt
+            else:
+                v_new[i, k] = vf
+                reaction[i, k] = 0.0
+
+
+@numba.njit(parallel=True, cache=True)
+def advance_kernel(x, v, v_new, mass, f_int, f_con, f_ext, f_damp, reaction, dt_mid, dt):
+    """Work increments of each force family, mid-step kinetic energy; then x += dt v_new, v = v_new.
+
+    Returns
+    -------
+    w_int, w_con, w_ext, w_damp, w_react, kinetic : float
+        Work (J) done on the body during the step by each family, and the kinetic energy at the
+        mid-step velocity (v_old + v_new) / 2.
+    """
+    n = x.shape[0]
+    w_int = 0.0
+    w_con = 0.0
+    w_ext = 0.0
+    w_damp = 0.0
+    w_react = 0.0
+    kinetic = 0.0
+    for i in numba.prange(n):
+        for k in range(3):
+            va = 0.5 * (v[i, k] + v_new[i, k])
+            w_int += f_int[i, k] * va
+            w_con += f_con[i, k] * va
+            w_ext += f_ext[i, k] * va
+            w_damp += f_damp[i, k] * va
+            w_react += reaction[i, k] * va
+            kinetic += 0.5 * mass[i] * va * va
+            x[i, k] += dt * v_new[i, k]
+            v[i, k] = v_new[i, k]
+    return w_int * dt_mid, w_con * dt_mid, w_ext * dt_mid, w_damp * dt_mid, w_react * dt_mid, kinetic
+
+
+# ---------------------------------------------------------------------------------------------
+# Constraints and loads
+# ---------------------------------------------------------------------------------------------
+
+
+class _Windowed:
+    """Active on the time window [start, end)."""
+
+    def _init_window(self, body, nodes, start, end):
+        self.body = body
+        if nodes is None:
+            nodes = np.arange(len(body.x0))
+        self.nodes = np.unique(np.asarray(nodes, dtype=np.int64).ravel())
+        if len(self.nodes) and (self.nodes.min() < 0 or self.nodes.max() >= len(body.x0)):
+            raise ColonsimError(f"constraint or load on body '{body.name}' names nodes that do not exist; fix the node list.")
+        if not end > start:
+            raise ColonsimError(f"time window [{start}, {end}) is empty; give end > start.")
+        self.start = float(start)
+        self.end = float(end)
+        self.reaction = np.zeros(3)
+
+    def active(self, t):
+        return self.start <= t < self.end
+
+
+class FixedNodes(_Windowed):
+    """Nodes held at rest (zero velocity) while active.
+
+    Parameters
+    ----------
+    body : body object
+    nodes : int array
+    start, end : float
+        Time window in which the constraint acts, s ("birth and death").
+    """
+
+    def __init__(self, body, nodes, start=0.0, end=math.inf):
+        self._init_window(body, nodes, start, end)
+
+
+class PrescribedVelocity(_Windowed):
+    """Nodes moving with a prescribed velocity while active.
+
+    Parameters
+    ----------
+    body : body object
+    nodes : int array
+    velocity : (3,) array or callable t -> (3,) array
+        Velocity, m/s.
+    ramp : float
+        Duration of a smooth (1 - cos) start-up ramp from the window start, s (0 = step).
+    start, end : float
+        Time window, s.
+    """
+
+    def __init__(self, body, nodes, velocity, ramp=0.0, start=0.0, end=math.inf):
+        self._init_window(body, nodes, start, end)
+        self._velocity = velocity if callable(velocity) else np.asarray(velocity, dtype=np.float64).reshape(3)
+        if ramp < 0.0:
+            raise ColonsimError(f"ramp = {ramp} s must be >= 0; fix it.")
+        self.ramp = float(ramp)
+
+    def velocity(self, t):
+        """Prescribed velocity at time t, m/s."""
+        v = np.asarray(self._velocity(t) if callable(self._velocity) else self._velocity, dtype=np.float64)
+        tau = t - self.start
+        if self.ramp > 0.0 and tau < self.ramp:
+            v = v * 0.5 * (1.0 - math.cos(math.pi * max(tau, 0.0) / self.ramp))
+        return v
+
+    def apply(self, t_mid, v_new, reaction, mass, dt_mid):
+        vc = self.velocity(t_mid)
+        idx = self.nodes
+        r = mass[idx, None] * (vc[None, :] - v_new[idx]) / dt_mid
+        reaction[idx] += r
+        v_new[idx] = vc
+        return r.sum(axis=0)
+
+
+class LineConstraint(_Windowed):
+    """Nodes confined to a straight line (a rigid sheath) while they lie inside its extent.
+
+    A node is guided when its coordinate along the line, s = (x - point) . direction, lies in
+    [s_min, s_max]: its velocity component across the line is removed (motion along the line stays
+    free). Nodes started on the line stay on it.
+
+    Parameters
+    ----------
+    body : body object
+    point, direction : (3,) arrays
+        A point of the line and its direction.
+    extent : (s_min, s_max)
+        Guided stretch of the line, m.
+    nodes : int array or None
+        Candidate nodes (None = all nodes of the body).
+    start, end : float
+        Time window, s.
+    """
+
+    def __init__(self, body, point, direction, extent=(-math.inf, math.inf), nodes=None, start=0.0, end=math.inf):
+        self._init_window(body, nodes, start, end)
+        d = np.asarray(direction, dtype=np.float64).reshape(3)
+        if not np.linalg.norm(d) > 0.0:
+            raise ColonsimError("line constraint direction must be a non-zero vector; fix it.")
+        self.direction = d / np.linalg.norm(d)
+        self.point = np.asarray(point, dtype=np.float64).reshape(3)
+        self.extent = (float(extent[0]), float(extent[1]))
+
+    def apply(self, x, v_new, reaction, mass, dt_mid):
+        idx = self.nodes
+        s = (x[idx] - self.point) @ self.direction
+        idx = idx[(s >= self.extent[0]) & (s <= self.extent[1])]
+        if len(idx) == 0:
+            return np.zeros(3)
+        vn = v_new[idx]
+        vc = np.outer(vn @ self.direction, self.direction)
+        r = mass[idx, None] * (vc - vn) / dt_mid
+        reaction[idx] += r
+        v_new[idx] = vc
+        return r.sum(axis=0)
+
+
+class NodalLoad(_Windowed):
+    """Applied nodal forces while active.
+
+    Parameters
+    ----------
+    body : body object
+    nodes : int array
+    force : (3,) array, (len(nodes), 3) array, or callable t -> one of those
+        Force per node, N.
+    start, end : float
+        Time window, s.
+    """
+
+    def __init__(self, body, nodes, force, start=0.0, end=math.inf):
+        nodes_arr = np.asarray(nodes, dtype=np.int64).ravel()
+        self._init_window(body, nodes, start, end)
+        if len(np.unique(nodes_arr)) != len(nodes_arr):
+            raise ColonsimError("a nodal load lists a node twice; give each node once.")
+        self.nodes = nodes_arr
+        self.force = force
+
+    def apply(self, t, f):
+        force = self.force(t) if callable(self.force) else self.force
+        f[self.nodes] += np.asarray(force, dtype=np.float64)
+
+
+# ---------------------------------------------------------------------------------------------
+# Solver
+# ---------------------------------------------------------------------------------------------
+
+
+class _BodyState:
+    """Positions, velocities and force/energy buffers of one body."""
+
+    def __init__(self, body, velocity):
+        n = len(body.x0)
+        self.body = body
+        self.x = np.ascontiguousarray(body.x0, dtype=np.float64).copy()
+        self.v = np.zeros((n, 3)) if velocity is None else np.ascontiguousarray(velocity, dtype=np.float64).copy()
+        if self.v.shape != (n, 3):
+            raise ColonsimError(f"initial velocity of body '{body.name}' must have shape {(n, 3)}; got {self.v.shape}.")
+        self.v_new = np.zeros((n, 3))
+        self.f_int = np.zeros((n, 3))
+        self.f_con = np.zeros((n, 3))
+        self.f_ext = np.zeros((n, 3))
+        self.f_damp = np.zeros((n, 3))
+        self.reaction = np.zeros((n, 3))
+        self.fixed = np.zeros(n, dtype=np.uint8)
+        self.internal = 0.0
+        self.kinetic = 0.0
+        self.work_internal = 0.0
+        self.work_contact = 0.0
+        self.work_external = 0.0
+        self.work_reaction = 0.0
+        self.dissipated_damping = 0.0
+
+
+class History:
+    """Time series recorded by :meth:`ExplicitSolver.run`.
+
+    Attributes
+    ----------
+    time : (k,) array, s
+    step : (k,) int array
+    bodies : dict
+        ``bodies[name][quantity]`` arrays: ``kinetic``, ``internal``, ``dissipated`` (damping),
+        ``external_work`` (loads + constraint reactions), ``contact_work`` (work of contact forces on
+        the body), ``positions`` (k, n, 3) if recorded.
+    contacts : list of dict
+        Per contact: ``energy`` (penalty), ``dissipated`` (contact damping + friction),
+        ``friction_dissipated``, ``normal_force`` (sum of normal forces, N), ``force_on_rod`` (k, 3),
+        ``n_active``, ``n_candidates``.
+    reactions : list of (k, 3) arrays
+        Total reaction force of each constraint (N), in the solver's constraint order.
+    """
+
+    def __init__(self):
+        self._rows = []
+
+    def _append(self, row):
+        self._rows.append(row)
+
+    def _finish(self, body_names, n_contacts, n_constraints):
+        rows = self._rows
+        self.time = np.array([r["time"] for r in rows])
+        self.step = np.array([r["step"] for r in rows], dtype=np.int64)
+        self.bodies = {}
+        for name in body_names:
+            d = {}
+            for q in ("kinetic", "internal", "dissipated", "external_work", "contact_work"):
+                d[q] = np.array([r["bodies"][name][q] for r in rows])
+            if rows and "positions" in rows[0]["bodies"][name]:
+                d["positions"] = np.array([r["bodies"][name]["positions"] for r in rows])
+            self.bodies[name] = d
+        self.contacts = []
+        for c in range(n_contacts):
+            keys = rows[0]["contacts"][c].keys() if rows else ()
+            self.contacts.append({q: np.array([r["contacts"][c][q] for r in rows]) for q in keys})
+        self.reactions = [np.array([r["reactions"][j] for r in rows]).reshape(-1, 3) for j in range(n_constraints)]
+        return self
+
+    def total_energy_balance(self):
+        """Energy balance residual (k,), J: sum of kinetic + internal + dissipated energy of all bodies
+        and contacts minus all external work; constant (its initial value) for a consistent run."""
+        total = np.zeros_like(self.time)
+        for d in self.bodies.values():
+            total += d["kinetic"] + d["internal"] + d["dissipated"] - d["external_work"]
+        for c in self.contacts:
+            total += c["energy"] + c["dissipated"]
+        return total
+
+
+class ExplicitSolver:
+    """Explicit dynamics of bodies (rod, shell) with contact, constraints and loads.
+
+    Parameters
+    ----------
+    bodies : list of body objects
+        Each with ``name``, ``x0``, ``mass``, ``internal_forces(x, f)``, ``critical_time_step(x)``.
+    contacts : list
+        Contact objects (:class:`insertion.contact.RodShellContact`).
+    constraints : list
+        :class:`FixedNodes`, :class:`PrescribedVelocity`, :class:`LineConstraint`.
+    loads : list
+        :class:`NodalLoad`.
+    damping : float or dict
+        Mass-proportional damping coefficient alpha (1/s), one for all bodies or per body name.
+        Critical damping of a mode of angular frequency w is alpha = 2 w.
+    time_step : float or None
+        Fixed time step, s; None = ``time_step_factor`` times the stable estimate, updated every
+        ``time_step_interval`` steps.
+    time_step_factor : float
+        Safety factor on the stable time step estimate (bodies and contact penalty).
+    time_step_interval : int
+        Steps between time step updates.
+    mass_scaling : float or None
+        Target time step, s: bodies whose stable step is smaller get their masses scaled uniformly
+        by (target / dt_body)^2 (the added mass is reported in ``added_mass``).
+    initial_velocity : dict or None
+        ``{body name: (n, 3) array}``, m/s.
+    energy_growth_limit : float
+        Divergence guard factor (see module docstring).
+    """
+
+    def __init__(self, bodies, contacts=(), constraints=(), loads=(), damping=0.0, time_step=None,
+                 time_step_factor=0.9, time_step_interval=100, mass_scaling=None, initial_velocity=None,
+                 energy_growth_limit=10.0):
+        names = [b.name for b in bodies]
+        if len(set(names)) != len(names):
+            raise ColonsimError(f"body names must be unique, got {names}; rename the bodies.")
+        if not 0.0 < time_step_factor <= 1.0:
+            raise ColonsimError(f"time_step_factor = {time_step_factor} must lie in (0, 1]; fix it.")
+        if time_step is not None and not time_step > 0.0:
+            raise ColonsimError(f"time_step = {time_step} s must be positive; fix it.")
+        self.bodies = list(bodies)
+        self.contacts = list(contacts)
+        self.constraints = list(constraints)
+        self.loads = list(loads)
+        for item in self.constraints + self.loads:
+            if item.body not in self.bodies:
+                raise ColonsimError(f"a constraint or load acts on body '{item.body.name}', which is not in the solver.")
+        if isinstance(damping, dict):
+            unknown = set(damping) - set(names)
+            if unknown:
+                raise ColonsimError(f"damping given for unknown bodies {sorted(unknown)}; use the names {names}.")
+            self.damping = {n: float(damping.get(n, 0.0)) for n in names}
+        else:
+            self.damping = {n: float(damping) for n in names}
+        if any(a < 0.0 for a in self.damping.values()):
+            raise ColonsimError("damping coefficients must be >= 0 1/s; fix them.")
+        initial_velocity = initial_velocity or {}
+        self.state = {b.name: _BodyState(b, initial_velocity.get(b.name)) for b in self.bodies}
+        self.fixed_time_step = time_step
+        self.time_step_factor = float(time_step_factor)
+        self.time_step_interval = int(time_step_interval)
+        self.energy_growth_limit = float(energy_growth_limit)
+        self.time = 0.0
+        self.step = 0
+        self.added_mass = {n: 0.0 for n in names}
+        if mass_scaling is not None:
+            self._scale_masses(float(mass_scaling))
+        self.dt = None
+        self._dt_prev = None
+        self._fixed_key = None
+        self._energy0 = None
+        self._work_in = 0.0
+
+    # -- time step --------------------------------------------------------------------------
+
+    def _scale_masses(self, target):
+        for b in self.bodies:
+            dt_b = b.critical_time_step(self.state[b.name].x)
+            if dt_b < target:
+                m0 = b.mass.sum()
+                b.mass[:] = b.mass * (target / dt_b) ** 2
+                self.added_mass[b.name] = float(b.mass.sum() - m0)
+
+    def stable_time_step(self):
+        """Stable time step estimate of the current state (before the safety factor), s.
+
+        Per body omega^2 = (2 / dt_body)^2 plus the contact penalty's contribution on that body
+        (Gershgorin: the stiffness rows add), then the contacts' own damping reduction.
+        """
+        omega2 = {b.name: (2.0 / b.critical_time_step(self.state[b.name].x)) ** 2 for b in self.bodies}
+        damping_factor = 1.0
+        for c in self.contacts:
+            for name, w2 in c.frequency_squared().items():
+                omega2[name] += w2
+            damping_factor = min(damping_factor, c.damping_reduction())
+        return damping_factor * 2.0 / math.sqrt(max(omega2.values()))
+
+    def _update_time_step(self):
+        if self.fixed_time_step is not None:
+            self.dt = self.fixed_time_step
+        else:
+            self.dt = self.time_step_factor * self.stable_time_step()
+
+    # -- one step ---------------------------------------------------------------------------
+
+    def _refresh_fixed(self, t):
+        active = tuple(isinstance(c, FixedNodes) and c.active(t) for c in self.constraints)
+        if active == self._fixed_key:
+            return
+        self._fixed_key = active
+        for s in self.state.values():
+            s.fixed[:] = 0
+        for c, on in zip(self.constraints, active):
+            if on:
+                self.state[c.body.name].fixed[c.nodes] = 1
+
+    def _diverged(self, why):
+        return ColonsimError(
+            f"simulation diverged at t = {self.time:.6g} s (step {self.step}): {why}; "
+            f"reduce time_step_factor (now {self.time_step_factor}) or the time step, or add damping."
+        )
+
+    def advance(self):
+        """Advance the state by one time step."""
+        if self.dt is None or (self.fixed_time_step is None and self.step % self.time_step_interval == 0):
+            try:
+                self._update_time_step()
+            except ColonsimError as err:
+                raise self._diverged(str(err)) from err
+        dt = self.dt
+        dt_mid = dt if self._dt_prev is None else 0.5 * (dt + self._dt_prev)
+        t = self.time
+        try:
+            for s in self.state.values():
+                s.f_int[:] = 0.0
+                s.internal = s.body.internal_forces(s.x, s.f_int)
+                s.f_con[:] = 0.0
+                s.f_ext[:] = 0.0
+            for c in self.contacts:
+                c.compute(self.state, dt_mid)
+        except ColonsimError as err:
+            raise self._diverged(str(err)) from err
+        for load in self.loads:
+            if load.active(t):
+                load.apply(t, self.state[load.body.name].f_ext)
+        self._refresh_fixed(t)
+        for b in self.bodies:
+            s = self.state[b.name]
+            velocity_kernel(s.v, s.f_int, s.f_con, s.f_ext, b.mass, s.fixed, self.damping[b.name], dt_mid,
+                            s.v_new, s.f_damp, s.reaction)
+        t_mid = t + 0.5 * dt
+        for c in self.constraints:
+            if isinstance(c, FixedNodes):
+                c.reaction = self.state[c.body.name].reaction[c.nodes].sum(axis=0) if c.active(t) else np.zeros(3)
+                continue
+            s = self.state[c.body.name]
+            if not c.active(t):
+                c.reaction = np.zeros(3)
+            elif isinstance(c, PrescribedVelocity):
+                c.reaction = c.apply(t_mid, s.v_new, s.reaction, c.body.mass, dt_mid)
+            else:
+                c.reaction = c.apply(s.x, s.v_new, s.reaction, c.body.mass, dt_mid)
+        energy = 0.0
+        work_in = 0.0
+        for b in self.bodies:
+            s = self.state[b.name]
+            w_int, w_con, w_ext, w_damp, w_react, kinetic = advance_kernel(
+                s.x, s.v, s.v_new, b.mass, s.f_int, s.f_con, s.f_ext, s.f_damp, s.reaction, dt_mid, dt
+            )
+            s.kinetic = kinetic
+            s.work_internal += w_int
+            s.work_contact += w_con
+            s.work_external += w_ext
+            s.work_reaction += w_react
+            s.dissipated_damping -= w_damp
+            energy += kinetic + s.internal
+            work_in += abs(w_ext) + abs(w_react)
+        for c in self.contacts:
+            c.finish_step(self.state, dt_mid)
+            energy += c.energy
+            work_in += abs(c.energy_in)
+        self._work_in += work_in
+        if self._energy0 is None:
+            self._energy0 = energy
+        self.time = t + dt
+        self.step += 1
+        self._dt_prev = dt
+        if not math.isfinite(energy):
+            raise self._diverged("the state is no longer finite (NaN or overflow)")
+        limit = self.energy_growth_limit * (abs(self._energy0) + self._work_in) + 1e-12
+        if energy > limit:
+            raise self._diverged(
+                f"mechanical energy {energy:.3g} J exceeds {self.energy_growth_limit:g} x the initial energy "
+                f"plus the work put in ({limit:.3g} J)"
+            )
+
+    # -- run --------------------------------------------------------------------------------
+
+    def _row(self, positions):
+        bodies = {}
+        for b in self.bodies:
+            s = self.state[b.name]
+            d = {
+                "kinetic": s.kinetic,
+                "internal": s.internal,
+                "dissipated": s.dissipated_damping,
+                "external_work": s.work_external + s.work_reaction,
+                "contact_work": s.work_contact,
+            }
+            if b.name in positions:
+                d["positions"] = s.x.copy()
+            bodies[b.name] = d
+        return {
+            "time": self.time,
+            "step": self.step,
+            "bodies": bodies,
+            "contacts": [c.record() for c in self.contacts],
+            "reactions": [np.asarray(c.reaction, dtype=np.float64).copy() for c in self.constraints],
+        }
+
+    def run(self, duration, record_interval=None, record_positions=(), callbacks=()):
+        """Integrate for ``duration`` seconds and return the recorded :class:`History`.
+
+        Parameters
+        ----------
+        duration : float
+            Simulated time, s.
+        record_interval : float or None
+            Simulated time between records, s (None = every step).
+        record_positions : iterable of str
+            Names of bodies whose positions are recorded.
+        callbacks : iterable of callables
+            Called as ``callback(solver)`` at every record.
+        """
+        if not duration > 0.0:
+            raise ColonsimError(f"duration = {duration} s must be positive; fix it.")
+        positions = set(record_positions)
+        history = History()
+        t_end = self.time + duration
+        next_record = self.time
+        # Stop within a hair of t_end so float round-off does not add a step.
+        while t_end - self.time > 1e-6 * (self.dt or 0.0):
+            self.advance()
+            if record_interval is None or self.time >= next_record - 1e-12:
+                history._append(self._row(positions))
+                for cb in callbacks:
+                    cb(self)
+                if record_interval is not None:
+                    while next_record <= self.time + 1e-12:
+                        next_record += record_interval
+        return history._finish([b.name for b in self.bodies], len(self.contacts), len(self.constraints))
