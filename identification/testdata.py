@@ -21,7 +21,7 @@ import numpy as np
 from colonsim.errors import ColonsimError
 
 LENGTH_UNITS = {"m": 1.0, "cm": 1e-2, "mm": 1e-3, "um": 1e-6, "µm": 1e-6, "in": 0.0254}
-FORCE_UNITS = {"n": 1.0, "kn": 1e3, "mn": 1e-3, "lbf": 4.4482216152605}  # keys lower-case
+FORCE_UNITS = {"n": 1.0, "kn": 1e3, "mn": 1e-3, "gf": 9.80665e-3, "kgf": 9.80665, "lbf": 4.4482216152605}  # keys lower-case
 _DISPLACEMENT_NAMES = ("displacement", "extension", "elongation", "disp", "position", "crosshead")
 _FORCE_NAMES = ("force", "load")
 _HEADER = re.compile(r"^\s*(?P<name>[A-Za-z][A-Za-z ]*?)\s*(?:\[(?P<u1>[^\]]*)\]|\((?P<u2>[^)]*)\)|_(?P<u3>[A-Za-zµ]+))?\s*$")
@@ -163,18 +163,18 @@ def read_curve(path, length, width, thickness, name=None, displacement_unit=None
     except (ValueError, IndexError) as exc:
         bad = next(i for i, r in enumerate(data) if not _row_ok(r, d_col, f_col))
         raise ColonsimError(
-            f"{path}: row {bad + 2} is not numeric or is short ({exc}); fix or remove it"
+            f"{path}: data row {bad + 1} is not numeric or is short ({exc}); fix or remove it"
         ) from None
     if not (np.all(np.isfinite(d)) and np.all(np.isfinite(f))):
         bad = int(np.flatnonzero(~(np.isfinite(d) & np.isfinite(f)))[0])
-        raise ColonsimError(f"{path}: NaN or infinite value at row {bad + 2}; remove the incomplete rows")
+        raise ColonsimError(f"{path}: NaN or infinite value at data row {bad + 1}; remove the incomplete rows")
     if d.size < 3:
         raise ColonsimError(f"{path}: only {d.size} data rows; a tensile curve needs many points")
     steps = np.diff(d)
     if np.any(steps <= 0):
         bad = int(np.flatnonzero(steps <= 0)[0])
         raise ColonsimError(
-            f"{path}: displacement is not strictly increasing at row {bad + 3} "
+            f"{path}: displacement is not strictly increasing at data row {bad + 2} "
             f"({d[bad]:g} then {d[bad + 1]:g}); keep only the loading branch and drop repeated samples"
         )
     return TensileCurve(name, d * units["displacement"], f * units["force"], float(length), float(width),
@@ -227,3 +227,30 @@ def write_curve(path, curve: TensileCurve, comment=None):
         fh.write("displacement [mm],force [N]\n")
         for d, f in zip(curve.displacement, curve.force):
             fh.write(f"{d * 1e3:.4f},{f:.4f}\n")
+
+
+def mean_curve(curves, step=0.25e-3, name="mean_curve") -> TensileCurve:
+    """The mean force curve of several specimens (the source's way of fitting one parameter set).
+
+    Every curve is linearly interpolated onto a common grid of ``step`` (m) up to the shortest
+    curve's last displacement (no extrapolation) and averaged; the thickness is the mean
+    thickness. All specimens must share length and width.
+    """
+    curves = list(curves)
+    if not curves:
+        raise ColonsimError("no curves to average")
+    for c in curves[1:]:
+        if not (np.isclose(c.length, curves[0].length) and np.isclose(c.width, curves[0].width)):
+            raise ColonsimError(
+                f"{c.name}: a mean curve needs specimens of equal length and width "
+                f"({c.length * 1e3:g} x {c.width * 1e3:g} mm vs {curves[0].length * 1e3:g} x {curves[0].width * 1e3:g} mm); "
+                "fit them separately with --per-specimen"
+            )
+    end = min(c.max_displacement for c in curves)
+    grid = np.arange(step, end + 1e-12, step)
+    if grid.size < 3:
+        raise ColonsimError(f"the shortest curve ends at {end * 1e3:.3g} mm: too short to average on a {step * 1e3:g} mm grid")
+    force = np.mean([np.interp(grid, c.displacement, c.force) for c in curves], axis=0)
+    thickness = float(np.mean([c.thickness for c in curves]))
+    return TensileCurve(name, grid, force, curves[0].length, curves[0].width, thickness,
+                        meta={"averaged_specimens": [c.name for c in curves]})

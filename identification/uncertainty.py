@@ -72,7 +72,7 @@ class FitUncertainty:
             "covariance": self.covariance.tolist(),
             "dof": self.dof,
             "residual_sd_N": self.residual_sd,
-            "condition_number_JTJ_scaled": self.condition_number,
+            "condition_number_JTJ_scaled": self.condition_number if np.isfinite(self.condition_number) else None,
             "joint_region": f"(theta - est)^T Sigma^-1 (theta - est) <= {self.region_threshold(level):.3f} ({level:.0%})",
         }
 

@@ -1,0 +1,231 @@
+"""The ``colonsim`` command line: thin wrappers that read options, run a workflow, print a report.
+
+Every error a user can cause is a :class:`colonsim.errors.ColonsimError`: printed as one line,
+exit code 2, no traceback.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import time
+from pathlib import Path
+
+from colonsim.errors import ColonsimError
+
+REPO_DATA = Path(__file__).resolve().parents[1] / "data"
+BUNDLED_MANIFEST = REPO_DATA / "tensile" / "manifest.csv"
+
+
+def _mesh(text):
+    try:
+        nl, nw = (int(v) for v in text.lower().split("x"))
+        if nl < 1 or nw < 1:
+            raise ValueError
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"mesh must look like 8x3 (divisions along the length x half-width), got {text!r}")
+    return nl, nw
+
+
+def _add_calibrate(sub):
+    p = sub.add_parser("calibrate", help="identify hyperelastic parameters from tensile test curves",
+                       description="Fit a hyperelastic law to strip tensile curves (SPEC.md 1): Latin-hypercube "
+                                   "sensitivity study -> CMA-ES -> Nelder-Mead on a scikit-fem model of the "
+                                   "clamped specimen. Writes material.json (read by the insertion solver), "
+                                   "CSV tables and figures.")
+    src = p.add_argument_group("test data (default: the bundled synthetic data set)")
+    src.add_argument("--manifest", type=Path,
+                     help="CSV listing specimens: specimen,file,length_mm,width_mm,thickness_mm")
+    src.add_argument("--curve", type=Path, help="one force-displacement CSV (give --length, --width, --thickness)")
+    src.add_argument("--length", type=float, help="free length between the grips, mm")
+    src.add_argument("--width", type=float, help="specimen width, mm")
+    src.add_argument("--thickness", type=float, help="wall thickness, mm")
+    src.add_argument("--displacement-unit", help="unit of the displacement column if the header does not say (mm, m, cm, um, in)")
+    src.add_argument("--force-unit", help="unit of the force column if the header does not say (N, mN, kN, gf, kgf, lbf)")
+    fit = p.add_argument_group("fit")
+    fit.add_argument("--per-specimen", action="store_true",
+                     help="fit every specimen separately and report the population mean and spread "
+                          "(default: fit the mean curve of all specimens, the source's way)")
+    fit.add_argument("--law", default="mooney_rivlin_3",
+                     help="mooney_rivlin_3 (default, SPEC.md 1.2), mooney_rivlin_2, neo_hookean, yeoh")
+    fit.add_argument("--analytic", action="store_true",
+                     help="fit the closed-form homogeneous uniaxial model instead of the clamped FE strip")
+    fit.add_argument("--mesh", type=_mesh, default=(8, 3), help="FE divisions of the quarter strip, default 8x3")
+    fit.add_argument("--points", type=int, default=20, help="simulation displacement points (default 20)")
+    fit.add_argument("--quick", action="store_true",
+                     help="reduced budget (40 designs, 100 CMA-ES, 160 Nelder-Mead evaluations) instead of 100/300/300")
+    fit.add_argument("--seed", type=int, default=1, help="seed of the Latin hypercube and CMA-ES (default 1)")
+    fit.add_argument("--workers", type=int, default=2, help="processes for --per-specimen (default 2)")
+    p.add_argument("--out", type=Path, default=Path("colonsim_results/calibration"),
+                   help="output folder (default colonsim_results/calibration)")
+    p.add_argument("--no-progress", action="store_true", help="no progress bar")
+    p.set_defaults(func=cmd_calibrate)
+
+
+def _load_curves(args):
+    from identification.testdata import read_curve, read_manifest
+
+    units = {"displacement_unit": args.displacement_unit, "force_unit": args.force_unit}
+    if args.curve and args.manifest:
+        raise ColonsimError("give either --curve or --manifest, not both")
+    if args.curve:
+        return [read_curve(args.curve, *(None if v is None else v * 1e-3 for v in (args.length, args.width, args.thickness)),
+                           **units)]
+    if any(v is not None for v in (args.length, args.width, args.thickness)):
+        raise ColonsimError("--length/--width/--thickness go with --curve; a manifest has its own geometry columns")
+    manifest = args.manifest or BUNDLED_MANIFEST
+    if args.manifest is None and not manifest.is_file():
+        raise ColonsimError(f"the bundled data set {manifest} is missing (install from a clone of the repository) "
+                            "or pass --manifest/--curve")
+    return read_manifest(manifest, **units)
+
+
+class _Progress:
+    """A tqdm bar over objective evaluations (or specimens), showing stage and best e1."""
+
+    def __init__(self, total, unit, enabled):
+        from tqdm import tqdm
+
+        self.bar = tqdm(total=total, unit=unit, disable=None if enabled else True, dynamic_ncols=True, leave=False, mininterval=0.5)
+        self.best = {}
+
+    def evaluation(self, name, stage, n, e1):
+        if stage is None:  # a whole specimen finished (process pool)
+            self.bar.set_postfix_str(f"{name} done")
+            self.bar.update(1)
+            return
+        self.best[name] = min(self.best.get(name, float("inf")), e1)
+        self.bar.set_postfix_str(f"{name} {stage} best e1 {self.best[name]:.4g} N^2")
+        self.bar.update(1)
+
+    def close(self):
+        self.bar.close()
+
+
+def _format_result(r) -> str:
+    from identification.report import material_document
+
+    doc = material_document(r)
+    unc, ci = r.uncertainty, r.uncertainty.interval()
+    lines = [f"{r.curve.name}: {r.model['model']}, law {r.model['law']}"]
+    for i, n in enumerate(r.names):
+        lines.append(f"  {n:>4} = {r.parameters[i]:12.1f} Pa   sd {unc.std[i]:10.1f}   95% [{ci[i, 0]:.1f}, {ci[i, 1]:.1f}]")
+    corr = unc.correlation
+    pairs = ", ".join(f"{r.names[i]}/{r.names[j]} {corr[i, j]:+.3f}" for i in range(len(r.names)) for j in range(i + 1, len(r.names)))
+    if pairs:
+        lines.append(f"  correlation: {pairs}")
+    ss = doc["small_strain"]
+    if ss["mu0_sd_Pa"] is not None:
+        lines.append(f"  mu0 = 2 (C10 + C01) = {ss['mu0_Pa']:.1f} Pa, sd {ss['mu0_sd_Pa']:.1f} (well identified even when the split is not)")
+    st = r.stages
+    lines.append(f"  objective e1: initial {st['initial']['e1']:.4g} -> sensitivity {st['sensitivity']['e1']:.4g} -> "
+                 f"CMA-ES {st['cma-es']['e1']:.4g} -> Nelder-Mead {st['nelder-mead']['e1']:.4g} N^2")
+    lines.append(f"  fit: RMS {r.fit['rms_N']:.4f} N, max {r.fit['max_abs_N']:.4f} N, R^2 {r.fit['r2']:.6f} "
+                 f"({r.fit['evaluations']} evaluations, {r.fit['wall_time_s']:.1f} s)")
+    mc = r.model_comparison
+    lines.append(f"  clamped FE vs closed form at these parameters: {100 * mc['fe_over_closed_form_minus_1_min']:+.2f} % to "
+                 f"{100 * mc['fe_over_closed_form_minus_1_max']:+.2f} % in force (end: {mc['force_end_fe_N']:.3f} vs "
+                 f"{mc['force_end_closed_form_N']:.3f} N)")
+    return "\n".join(lines)
+
+
+def run_calibration(args, out: Path) -> list:
+    """Load the curves named by ``args``, calibrate, write results into ``out``; return the results."""
+    from identification.laws import get_law
+    from identification.pipeline import Budget
+    from identification.population import calibrate_curve, calibrate_specimens, population_summary, population_table, write_population
+    from identification.report import write_calibration
+    from identification.testdata import mean_curve
+
+    get_law(args.law)
+    if args.points < 5:
+        raise ColonsimError(f"--points {args.points} is too few to fit 3 parameters; use at least 5 (default 20)")
+    curves = _load_curves(args)
+    budget = Budget.quick() if args.quick else Budget()
+    options = dict(law=args.law, analytic=args.analytic, budget=budget, seed=args.seed, n_points=args.points)
+    if not args.analytic:
+        options.update(n_length=args.mesh[0], n_width=args.mesh[1])
+    per_eval = 1 + budget.designs + budget.cma_max_evaluations + budget.cma_popsize + budget.nm_max_evaluations
+    show = not args.no_progress
+    if args.per_specimen:
+        workers = max(1, min(args.workers, len(curves)))
+        print(f"fitting {len(curves)} specimens separately ({workers} process{'es' if workers > 1 else ''}, "
+              f"{'quick' if args.quick else 'full'} budget) ...", flush=True)
+        bar = _Progress(len(curves) if workers > 1 else per_eval * len(curves),
+                        "specimen" if workers > 1 else "eval", show)
+        try:
+            results = calibrate_specimens(curves, workers=workers, progress=bar.evaluation, **options)
+        finally:
+            bar.close()
+        paths = write_population(results, out)
+        for r in results:
+            print(_format_result(r))
+        summary = population_summary(population_table(results), results[0].names)
+        print("population (between-specimen mean +- sd):")
+        for n, s in summary.items():
+            print(f"  {n:>4} = {s['mean_Pa']:12.1f} +- {s['sd_Pa']:.1f} Pa")
+        print(f"results: {out}/ (population.json, population.csv, population.png, one folder per specimen)")
+        return results
+    curve = curves[0] if len(curves) == 1 else mean_curve(curves)
+    if len(curves) > 1:
+        print(f"fitting the mean curve of {len(curves)} specimens (mean thickness {curve.thickness * 1e3:.3f} mm; "
+              "--per-specimen fits each one)", flush=True)
+    bar = _Progress(per_eval, "eval", show)
+    try:
+        result = calibrate_curve(curve, progress=lambda stage, n, e1: bar.evaluation(curve.name, stage, n, e1), **options)
+    finally:
+        bar.close()
+    paths = write_calibration(result, out)
+    print(_format_result(result))
+    print(f"results: {paths['material']} (+ history.csv, sensitivity.csv, top10_designs.csv, fit.csv, *.png in {out}/)")
+    return [result]
+
+
+def cmd_calibrate(args):
+    run_calibration(args, args.out)
+
+
+def cmd_demo(args):
+    t0 = time.perf_counter()
+    out = args.out
+    print("colonsim demo: calibrate Mooney-Rivlin parameters from the bundled SYNTHETIC tensile data "
+          "(data/README.md), reduced budget (--quick).", flush=True)
+    cal = argparse.Namespace(manifest=None, curve=None, length=None, width=None, thickness=None,
+                             displacement_unit=None, force_unit=None, per_specimen=False, law="mooney_rivlin_3",
+                             analytic=False, mesh=(8, 3), points=20, quick=True, seed=1, workers=1,
+                             no_progress=args.no_progress)
+    run_calibration(cal, out / "calibration")
+    print(f"\ndemo finished in {time.perf_counter() - t0:.0f} s; outputs in {out}/")
+    print("Not there yet: the insertion solver (issue 3), colonoscopy scenarios (4), sweeps and the surrogate (5). "
+          "The demo will run them as they land.")
+
+
+def build_parser():
+    from colonsim import __version__
+
+    parser = argparse.ArgumentParser(prog="colonsim", description="Colonoscope-colon interaction toolkit.")
+    parser.add_argument("--version", action="version", version=f"colonsim {__version__}")
+    sub = parser.add_subparsers(dest="command", required=True)
+    _add_calibrate(sub)
+    demo = sub.add_parser("demo", help="run the workflows on the bundled data (a few minutes on 2 cores)")
+    demo.add_argument("--out", type=Path, default=Path("colonsim_demo"), help="output folder (default colonsim_demo)")
+    demo.add_argument("--no-progress", action="store_true", help="no progress bar")
+    demo.set_defaults(func=cmd_demo)
+    return parser
+
+
+def main(argv=None):
+    args = build_parser().parse_args(argv)
+    try:
+        args.func(args)
+    except ColonsimError as exc:
+        print(f"colonsim: error: {exc}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        print("colonsim: interrupted; files written so far are complete", file=sys.stderr)
+        return 130
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
