@@ -200,9 +200,12 @@ def membrane_omega2_kernel(x, tri, dm_inv, thickness, density, C10, C01, C11, ma
 
     Element eigenvalue bound (Irons): the lumped element mass is density t A / 3 per node
     (times the smallest mass-scaling factor of its nodes) and
-    u.K_e.u <= t A Cmax |grad u|^2 <= t A Cmax lambda_max(G) |u|^2, with G_ij = g_i . g_j the
-    Gram matrix of the shape function gradients and Cmax a bound of the current tangent modulus
-    (geometric stress term + max(a, b) times the largest eigenvalue of the material tangent).
+    u.K_e.u = t A H:A:H <= t A a_max |H|^2 <= t A a_max lambda_max(G) |u|^2, with H = grad u,
+    G_ij = g_i . g_j the Gram matrix of the shape function gradients and a_max the exact largest
+    eigenvalue of the current tangent A = d2W/dF2. For the reduced energy Psi(l1, l2) of the
+    in-plane principal stretches, A splits into the normal block d2Psi/dl_i dl_j, the in-plane
+    shear pair with eigenvalues (Psi_1 - Psi_2)/(l1 - l2) and (Psi_1 + Psi_2)/(l1 + l2), and the
+    out-of-plane (membrane tension) terms Psi_i / l_i.
     """
     nt = tri.shape[0]
     for e in numba.prange(nt):
@@ -231,15 +234,23 @@ def membrane_omega2_kernel(x, tri, dm_inv, thickness, density, C10, C01, C11, ma
         if pb <= 0.0:
             out[e] = np.inf
             continue
+        # S_i = 2 dW/dC_i, c_ij = 4 d2W/dC_i dC_j in the principal values of C.
         s_a, caa, cab = _mr_principal(pa, pb, C10, C01, C11)
         s_b, cbb, _ = _mr_principal(pb, pa, C10, C01, C11)
-        # In-plane shear modulus C_1212 = (S_a - S_b)/(a - b), its limit when a -> b.
-        if pa - pb > 1e-6 * pa:
-            c_shear = (s_a - s_b) / (pa - pb)
+        la = math.sqrt(pa)
+        lb = math.sqrt(pb)
+        # Psi_i = l_i S_i, Psi_ii = S_i + C_i c_ii, Psi_ab = l_a l_b c_ab.
+        psi_a = la * s_a
+        psi_b = lb * s_b
+        psi_aa = s_a + pa * caa
+        psi_bb = s_b + pb * cbb
+        psi_ab = la * lb * cab
+        a_max = _sym2_max_eig(psi_aa, psi_ab, psi_bb)
+        if la - lb > 1e-6 * la:
+            shear = (psi_a - psi_b) / (la - lb)
         else:
-            c_shear = 0.5 * (caa - cab)
-        lam_mat = max(_sym2_max_eig(caa, cab, cbb), 2.0 * c_shear, 0.0)
-        cmax = max(s_a, s_b, 0.0) + pa * lam_mat
+            shear = psi_aa - psi_ab
+        a_max = max(a_max, shear, (psi_a + psi_b) / (la + lb), s_a, s_b, 0.0)
         # Shape-function gradient Gram matrix: rows of Dm_inv are g_1, g_2; g_0 = -(g_1 + g_2).
         # Nonzero eigenvalues of G equal those of B^T B with B = [g_0; g_1; g_2] (3x2).
         g1x = m00
@@ -253,7 +264,7 @@ def membrane_omega2_kernel(x, tri, dm_inv, thickness, density, C10, C01, C11, ma
         bxy = g0x * g0y + g1x * g1y + g2x * g2y
         lam_g = _sym2_max_eig(bxx, bxy, byy)
         smin = min(mass_scale[i0], mass_scale[i1], mass_scale[i2])
-        out[e] = 3.0 * cmax * lam_g / (density * smin)
+        out[e] = 3.0 * a_max * lam_g / (density * smin)
 
 
 # ---------------------------------------------------------------------------------------------
