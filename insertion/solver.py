@@ -403,15 +403,14 @@ class ExplicitSolver:
         """Stable time step estimate of the current state (before the safety factor), s.
 
         Per body omega^2 = (2 / dt_body)^2 plus the contact penalty's contribution on that body
-        (Gershgorin: the stiffness rows add), then the contacts' own damping reduction.
+        (Gershgorin: the stiffness rows add; a contact reports its damped springs as equivalent
+        undamped ones).
         """
         omega2 = {b.name: (2.0 / b.critical_time_step(self.state[b.name].x)) ** 2 for b in self.bodies}
-        damping_factor = 1.0
         for c in self.contacts:
             for name, w2 in c.frequency_squared().items():
                 omega2[name] += w2
-            damping_factor = min(damping_factor, c.damping_reduction())
-        return damping_factor * 2.0 / math.sqrt(max(omega2.values()))
+        return 2.0 / math.sqrt(max(omega2.values()))
 
     def _update_time_step(self):
         if self.fixed_time_step is not None:
@@ -496,7 +495,6 @@ class ExplicitSolver:
         for c in self.contacts:
             c.finish_step(self.state, dt_mid)
             energy += c.energy
-            work_in += abs(c.energy_in)
         self._work_in += work_in
         if self._energy0 is None:
             self._energy0 = energy
