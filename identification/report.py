@@ -122,7 +122,7 @@ def fit_figure(result: CalibrationResult) -> Figure:
     ax.plot(f["displacement_mm"], f["force_fit_N"], "-", c="tab:red", label="fitted model")
     ax.set_ylabel("force [N]")
     ax.legend(fontsize=8)
-    ax.set_title(f"R$^2$ = {result.fit['r2']:.5f}, RMS error = {result.fit['rms_N']:.3g} N", fontsize=9)
+    ax.set_title(f"R$^2$ = {result.fit['r2']:.6f}, RMS error = {result.fit['rms_N']:.3g} N", fontsize=9)
     ax_r.axhline(0.0, c="0.6", lw=0.8)
     ax_r.plot(f["displacement_mm"], f["force_exp_N"] - f["force_fit_N"], "o-", ms=3, c="tab:red")
     ax_r.set_xlabel("grip displacement [mm]")

@@ -5,6 +5,7 @@ energy per unit area of the sheet's interior must be the plate value D / (2 R^2)
 D = E0 t^3 / 9 (nu = 1/2), whatever the cylinder's direction relative to the mesh.
 """
 
+import numba
 import numpy as np
 import pytest
 
@@ -15,6 +16,16 @@ from insertion.shell import Shell, dihedral_angles
 MATERIAL = load_material(REFERENCE_MATERIAL_PATH)
 THICKNESS = 0.002
 SIDE, H = 0.06, 0.003  # 516 nodes; the interior (2 h from the edges) holds ~900 hinges
+
+
+@pytest.fixture
+def serial_kernels():
+    """Run the kernels on one thread: these checks call them hundreds of times on tiny meshes,
+    where waking a second thread on a loaded machine costs more than the work itself."""
+    previous = numba.get_num_threads()
+    numba.set_num_threads(1)
+    yield
+    numba.set_num_threads(previous)
 
 
 def _bending(shell, x):
@@ -108,7 +119,7 @@ def test_spherical_bending_shows_documented_hinge_poisson_ratio():
     assert density == pytest.approx(2.0 / 3.0 * shell.bending_stiffness / radius**2, rel=1e-2)
 
 
-def test_hinge_forces_are_minus_energy_gradient():
+def test_hinge_forces_are_minus_energy_gradient(serial_kernels):
     """Central differences of the hinge energy on a randomly perturbed tube (curved reference,
     theta0 != 0); step 1e-7 m, tolerance 1e-6 of the largest force (measured ~1e-9)."""
     nodes, tri, _ = straight_tube(0.03, 0.02, 0.006)

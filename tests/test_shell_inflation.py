@@ -19,6 +19,7 @@ the discrete relation is p(l) / cos(pi / m) (+0.34 % for m = 38).
 
 import os
 
+import numba
 import numpy as np
 import pytest
 
@@ -30,6 +31,16 @@ from insertion.statics import minimize_energy
 MATERIAL = load_material(REFERENCE_MATERIAL_PATH)
 RADIUS, THICKNESS, H = 0.018, 0.002, 0.003
 FULL = os.environ.get("COLONSIM_FULL") == "1"
+
+
+@pytest.fixture
+def serial_kernels():
+    """Run the kernels on one thread: these checks call them hundreds of times on tiny meshes,
+    where waking a second thread on a loaded machine costs more than the work itself."""
+    previous = numba.get_num_threads()
+    numba.set_num_threads(1)
+    yield
+    numba.set_num_threads(previous)
 
 
 def thin_wall_pressure(stretch):
@@ -46,7 +57,7 @@ def _tube(length):
     return shell, ring, np.cos(np.pi / per_ring)
 
 
-def test_pressure_load_is_volume_gradient():
+def test_pressure_load_is_volume_gradient(serial_kernels):
     """On nodes away from the open ends the follower pressure load per pascal equals the gradient
     of ``enclosed_volume`` (what makes -p V the pressure's potential); central differences,
     tolerance 1e-6 of the largest load (round-off ~ 1e-16 V / 1e-7 m)."""
@@ -81,12 +92,12 @@ def _closed_volume(shell, x, last_ring, length):
 
 
 @pytest.mark.parametrize("stretch", [1.05, 1.2, 1.4, 1.6])
-def test_plane_strain_section_follows_thin_wall_theory(stretch):
+def test_plane_strain_section_follows_thin_wall_theory(stretch, serial_kernels):
     """A tube section with every node's axial coordinate fixed (axial stretch 1, ends free to
     expand: a periodic slice of an infinitely long tube) under p(l) / cos(pi/m).
 
     Static solve of the membrane + hinge energy minus p V. The section must expand uniformly to
-    l within 1e-3 (measured: 3e-5 at l = 1.05 up to 3e-4 at l = 1.6, the remainder from the
+    l within 1e-3 (measured: 3e-5 at l = 1.05 up to 3.5e-4 at l = 1.6, the remainder from the
     ring-to-ring triangles tilting slightly out of the hoop plane; hinges stay unbent under
     uniform inflation because the dihedral angles of the inscribed polygon do not change).
     """
@@ -111,10 +122,10 @@ def test_plane_strain_section_follows_thin_wall_theory(stretch):
 @pytest.mark.slow
 def test_tube_with_fixed_ends_follows_thin_wall_theory_in_the_middle():
     """A tube with both end rings clamped and every axial coordinate fixed; away from the ends
-    the wall must reach the plane-strain thin-wall stretch. The clamped rings pull the wall back
-    over a boundary layer that lengthens with the stretch (at L = 4 R and l = 1.4 the middle
-    is still 0.4 % short), so the reduced test (L = 6 R, l = 1.2) allows 0.3 % on the middle
-    ring's stretch and the full one (L = 10 R) checks l = 1.1, 1.2, 1.3 to 0.2 %.
+    the wall must reach the plane-strain thin-wall stretch. The clamped rings hold the wall back
+    over a boundary layer a few radii long, so the middle ring is checked: reduced size L = 6 R at
+    l = 1.2, full size L = 10 R at l = 1.1, 1.2, 1.3, both to 1e-3 on the stretch (measured
+    5e-5 reduced, at most 1e-4 full).
     """
     length = (10.0 if FULL else 6.0) * RADIUS
     shell, ring, cos_factor = _tube(length)
@@ -135,4 +146,4 @@ def test_tube_with_fixed_ends_follows_thin_wall_theory_in_the_middle():
 
         x, _ = minimize_energy(x, free, potential, force_tol=1e-5 * pressure * H**2)
         r = np.hypot(x[middle, 1], x[middle, 2]) / RADIUS
-        assert r.mean() == pytest.approx(stretch, rel=2e-3 if FULL else 3e-3)
+        assert r.mean() == pytest.approx(stretch, rel=1e-3)

@@ -1,6 +1,7 @@
 """Membrane of the shell: forces are the energy gradient, and homogeneous uniaxial tension of a
 flat triangulated sheet reproduces the closed-form incompressible Mooney-Rivlin nominal stress."""
 
+import numba
 import numpy as np
 import pytest
 
@@ -20,6 +21,16 @@ MATERIALS = {
 LENGTH, WIDTH, THICKNESS, H = 0.10, 0.025, 0.002, 0.005
 
 
+@pytest.fixture
+def serial_kernels():
+    """Run the kernels on one thread: these checks call them hundreds of times on tiny meshes,
+    where waking a second thread on a loaded machine costs more than the work itself."""
+    previous = numba.get_num_threads()
+    numba.set_num_threads(1)
+    yield
+    numba.set_num_threads(previous)
+
+
 def _sheet(material):
     nodes, tri = flat_sheet(LENGTH, WIDTH, H)
     return Shell(nodes, tri, THICKNESS, material)
@@ -31,7 +42,7 @@ def _membrane(shell, x):
     return energy, f
 
 
-def test_membrane_forces_are_minus_energy_gradient():
+def test_membrane_forces_are_minus_energy_gradient(serial_kernels):
     """Central differences of the energy on a randomly deformed sheet (strains up to ~30 %).
 
     Step 1e-7 m: truncation error ~ h^2 |E'''| and round-off ~ 1e-16 E / h are both far below
