@@ -125,17 +125,86 @@ def candidate_fill(xs, xr, seg, keys, ids, cutoff, cell, nodes, ptr, out):
                 p += 1
 
 
-@numba.njit(parallel=True, cache=True)
+@numba.njit(cache=True)
 def max_displacement(x, x_ref):
-    """Largest nodal distance between x and x_ref, m."""
-    n = x.shape[0]
-    out = np.zeros(n)
-    for i in numba.prange(n):
+    """Largest nodal distance between x and x_ref, m (serial: a few flops per node)."""
+    worst = 0.0
+    for i in range(x.shape[0]):
         d0 = x[i, 0] - x_ref[i, 0]
         d1 = x[i, 1] - x_ref[i, 1]
         d2 = x[i, 2] - x_ref[i, 2]
-        out[i] = d0 * d0 + d1 * d1 + d2 * d2
-    return math.sqrt(out.max()) if n else 0.0
+        worst = max(worst, d0 * d0 + d1 * d1 + d2 * d2)
+    return math.sqrt(worst)
+
+
+@numba.njit(cache=True, inline="always")
+def _contact_one(c, xs, vs, ms, fixed_s, xr, vr, mr, seg, nodes, ptr, cand, radius, offset, k, zeta, mu,
+                 v_slip, dt, fs, rod_seg, rod_t, rod_f, damp_f, fric_f):
+    """Contact of candidate wall node ``nodes[c]``: (energy, damping power, friction power,
+    active 0/1, normal force)."""
+    reach = radius + offset
+    rod_seg[c] = -1
+    i = nodes[c]
+    best = np.inf
+    best_s = -1
+    best_t = 0.0
+    for p in range(ptr[c], ptr[c + 1]):
+        s = cand[p]
+        d2, t = _point_segment(xs, i, xr, seg[s, 0], seg[s, 1])
+        if d2 < best:
+            best = d2
+            best_s = s
+            best_t = t
+    if best_s < 0 or best >= reach * reach or best <= 0.0:
+        return 0.0, 0.0, 0.0, 0, 0.0
+    dist = math.sqrt(best)
+    pen = reach - dist
+    a = seg[best_s, 0]
+    b = seg[best_s, 1]
+    t = best_t
+    n0 = (xs[i, 0] - ((1.0 - t) * xr[a, 0] + t * xr[b, 0])) / dist
+    n1 = (xs[i, 1] - ((1.0 - t) * xr[a, 1] + t * xr[b, 1])) / dist
+    n2 = (xs[i, 2] - ((1.0 - t) * xr[a, 2] + t * xr[b, 2])) / dist
+    mrc = (1.0 - t) * mr[a] + t * mr[b]
+    meff = mrc if fixed_s[i] else ms[i] * mrc / (ms[i] + mrc)
+    u0 = vs[i, 0] - ((1.0 - t) * vr[a, 0] + t * vr[b, 0])
+    u1 = vs[i, 1] - ((1.0 - t) * vr[a, 1] + t * vr[b, 1])
+    u2 = vs[i, 2] - ((1.0 - t) * vr[a, 2] + t * vr[b, 2])
+    vn = u0 * n0 + u1 * n1 + u2 * n2
+    elastic = k * pen
+    fn = elastic - 2.0 * zeta * math.sqrt(k * meff) * vn
+    if fn < 0.0:
+        fn = 0.0
+    energy = 0.5 * k * pen * pen
+    p_damp = -(fn - elastic) * vn
+    damp_f[c, 0] = (fn - elastic) * n0
+    damp_f[c, 1] = (fn - elastic) * n1
+    damp_f[c, 2] = (fn - elastic) * n2
+    t0 = u0 - vn * n0
+    t1 = u1 - vn * n1
+    t2 = u2 - vn * n2
+    vt = math.sqrt(t0 * t0 + t1 * t1 + t2 * t2)
+    ft = 0.0
+    p_fric = 0.0
+    if mu > 0.0 and fn > 0.0:
+        vreg = max(v_slip, mu * fn * dt / meff)
+        ft = mu * fn / max(vt, vreg)
+        p_fric = ft * vt * vt
+    fric_f[c, 0] = -ft * t0
+    fric_f[c, 1] = -ft * t1
+    fric_f[c, 2] = -ft * t2
+    f0 = fn * n0 - ft * t0
+    f1 = fn * n1 - ft * t1
+    f2 = fn * n2 - ft * t2
+    fs[i, 0] += f0
+    fs[i, 1] += f1
+    fs[i, 2] += f2
+    rod_seg[c] = best_s
+    rod_t[c] = t
+    rod_f[c, 0] = -f0
+    rod_f[c, 1] = -f1
+    rod_f[c, 2] = -f2
+    return energy, p_damp, p_fric, 1, fn
 
 
 @numba.njit(parallel=True, cache=True)
@@ -155,85 +224,49 @@ def contact_kernel(xs, vs, ms, fixed_s, xr, vr, mr, seg, nodes, ptr, cand, radiu
     normal : float
         Sum of the normal forces, N.
     """
-    nc = nodes.shape[0]
     energy = 0.0
     p_damp = 0.0
     p_fric = 0.0
     n_active = 0
     normal = 0.0
-    reach = radius + offset
-    for c in numba.prange(nc):
-        rod_seg[c] = -1
-        i = nodes[c]
-        best = np.inf
-        best_s = -1
-        best_t = 0.0
-        for p in range(ptr[c], ptr[c + 1]):
-            s = cand[p]
-            d2, t = _point_segment(xs, i, xr, seg[s, 0], seg[s, 1])
-            if d2 < best:
-                best = d2
-                best_s = s
-                best_t = t
-        if best_s < 0 or best >= reach * reach or best <= 0.0:
-            continue
-        dist = math.sqrt(best)
-        pen = reach - dist
-        a = seg[best_s, 0]
-        b = seg[best_s, 1]
-        t = best_t
-        n0 = (xs[i, 0] - ((1.0 - t) * xr[a, 0] + t * xr[b, 0])) / dist
-        n1 = (xs[i, 1] - ((1.0 - t) * xr[a, 1] + t * xr[b, 1])) / dist
-        n2 = (xs[i, 2] - ((1.0 - t) * xr[a, 2] + t * xr[b, 2])) / dist
-        mrc = (1.0 - t) * mr[a] + t * mr[b]
-        meff = mrc if fixed_s[i] else ms[i] * mrc / (ms[i] + mrc)
-        u0 = vs[i, 0] - ((1.0 - t) * vr[a, 0] + t * vr[b, 0])
-        u1 = vs[i, 1] - ((1.0 - t) * vr[a, 1] + t * vr[b, 1])
-        u2 = vs[i, 2] - ((1.0 - t) * vr[a, 2] + t * vr[b, 2])
-        vn = u0 * n0 + u1 * n1 + u2 * n2
-        elastic = k * pen
-        fn = elastic - 2.0 * zeta * math.sqrt(k * meff) * vn
-        if fn < 0.0:
-            fn = 0.0
-        energy += 0.5 * k * pen * pen
-        p_damp += -(fn - elastic) * vn
-        damp_f[c, 0] = (fn - elastic) * n0
-        damp_f[c, 1] = (fn - elastic) * n1
-        damp_f[c, 2] = (fn - elastic) * n2
-        t0 = u0 - vn * n0
-        t1 = u1 - vn * n1
-        t2 = u2 - vn * n2
-        vt = math.sqrt(t0 * t0 + t1 * t1 + t2 * t2)
-        ft = 0.0
-        if mu > 0.0 and fn > 0.0:
-            vreg = max(v_slip, mu * fn * dt / meff)
-            ft = mu * fn / max(vt, vreg)
-            p_fric += ft * vt * vt
-        fric_f[c, 0] = -ft * t0
-        fric_f[c, 1] = -ft * t1
-        fric_f[c, 2] = -ft * t2
-        f0 = fn * n0 - ft * t0
-        f1 = fn * n1 - ft * t1
-        f2 = fn * n2 - ft * t2
-        fs[i, 0] += f0
-        fs[i, 1] += f1
-        fs[i, 2] += f2
-        rod_seg[c] = best_s
-        rod_t[c] = t
-        rod_f[c, 0] = -f0
-        rod_f[c, 1] = -f1
-        rod_f[c, 2] = -f2
-        n_active += 1
+    for c in numba.prange(nodes.shape[0]):
+        e, pd, pf, a, fn = _contact_one(c, xs, vs, ms, fixed_s, xr, vr, mr, seg, nodes, ptr, cand, radius, offset,
+                                        k, zeta, mu, v_slip, dt, fs, rod_seg, rod_t, rod_f, damp_f, fric_f)
+        energy += e
+        p_damp += pd
+        p_fric += pf
+        n_active += a
         normal += fn
     return energy, p_damp, p_fric, n_active, normal
 
 
-@numba.njit(parallel=True, cache=True)
-def dissipation_rates(vs, vr, seg, nodes, rod_seg, rod_t, damp_f, fric_f):
-    """Power (W, >= 0) taken out by the stored damping and friction forces at velocities vs, vr."""
+@numba.njit(cache=True)
+def contact_kernel_serial(xs, vs, ms, fixed_s, xr, vr, mr, seg, nodes, ptr, cand, radius, offset, k, zeta,
+                          mu, v_slip, dt, fs, rod_seg, rod_t, rod_f, damp_f, fric_f):
+    """Serial :func:`contact_kernel` for candidate lists too short to pay for threads."""
+    energy = 0.0
     p_damp = 0.0
     p_fric = 0.0
-    for c in numba.prange(nodes.shape[0]):
+    n_active = 0
+    normal = 0.0
+    for c in range(nodes.shape[0]):
+        e, pd, pf, a, fn = _contact_one(c, xs, vs, ms, fixed_s, xr, vr, mr, seg, nodes, ptr, cand, radius, offset,
+                                        k, zeta, mu, v_slip, dt, fs, rod_seg, rod_t, rod_f, damp_f, fric_f)
+        energy += e
+        p_damp += pd
+        p_fric += pf
+        n_active += a
+        normal += fn
+    return energy, p_damp, p_fric, n_active, normal
+
+
+@numba.njit(cache=True)
+def dissipation_rates(vs, vr, seg, nodes, rod_seg, rod_t, damp_f, fric_f):
+    """Power (W, >= 0) taken out by the stored damping and friction forces at velocities vs, vr
+    (serial: a few flops per contact)."""
+    p_damp = 0.0
+    p_fric = 0.0
+    for c in range(nodes.shape[0]):
         s = rod_seg[c]
         if s < 0:
             continue
@@ -326,6 +359,8 @@ class RodShellContact:
         self._xr_build = None
         self._xs_build = None
         self.n_rebuilds = 0
+        # below this many candidate wall nodes the narrow phase runs serially (cheaper than threads)
+        self.parallel_min_candidates = 20_000
         self._nodes = np.zeros(0, dtype=np.int64)
         self._ptr = np.zeros(1, dtype=np.int64)
         self._cand = np.zeros(0, dtype=np.int64)
@@ -382,7 +417,8 @@ class RodShellContact:
         s = state[self.shell.name]
         if self._needs_rebuild(r.x, s.x):
             self.build_candidates(r.x, s.x)
-        energy, p_damp, p_fric, n_active, normal = contact_kernel(
+        kernel = contact_kernel if len(self._nodes) >= self.parallel_min_candidates else contact_kernel_serial
+        energy, p_damp, p_fric, n_active, normal = kernel(
             s.x, s.v, self.shell.mass, s.fixed, r.x, r.v, self.rod.mass, self.rod.segments, self._nodes, self._ptr,
             self._cand, self.rod.radius, self.offset, self.stiffness, self.damping_ratio, self.friction,
             self.slip_velocity, dt, s.f_con, self._rod_seg, self._rod_t, self._rod_f, self._damp_f, self._fric_f,

@@ -14,8 +14,8 @@ applied torque, so twist decouples from bending and stretching (no material fram
 Contact sees the rod as capsules of radius ``radius`` around its segments; at the distal end
 (``tip_node``) the end cap is the hemispherical tip, centred on the tip node.
 
-Kernels are ``numba`` functions writing per-element buffers that
-:func:`insertion._scatter.gather` sums onto nodes without races.
+Kernels are serial ``numba`` functions: a scope has a few hundred elements, too little work
+to pay for starting threads, and a serial loop adds element forces onto nodes without races.
 """
 
 import math
@@ -24,7 +24,6 @@ import numba
 import numpy as np
 
 from colonsim.errors import ColonsimError
-from insertion._scatter import gather, node_incidence
 
 
 @numba.njit(cache=True, inline="always")
@@ -53,56 +52,52 @@ def _turning(x, i0, i1, i2):
     return phi, s, c, la, lb, a0, a1, a2, b0, b1, b2
 
 
-@numba.njit(parallel=True, cache=True)
-def rod_kernel(x, rest_length, axial_k, bend_k, seg_f, vert_f):
-    """Axial and bending forces of a node chain into per-element buffers.
+@numba.njit(cache=True)
+def rod_kernel(x, rest_length, axial_k, bend_k, f):
+    """Add the axial and bending forces of a node chain into ``f`` (n, 3).
+
+    Serial on purpose: a scope has a few hundred elements, less work than starting threads
+    (which on a loaded machine costs milliseconds), and a serial loop scatters without races.
 
     Parameters
     ----------
     x : (n, 3) positions, m
     rest_length, axial_k : (n - 1,) reference lengths (m) and EA / L0 (N/m) of the segments
     bend_k : (n - 2,) EI / lbar of the interior nodes, N m
-    seg_f : (n - 1, 2, 3) out, forces of each segment on its two nodes
-    vert_f : (n - 2, 3, 3) out, forces of each hinge on nodes i - 1, i, i + 1
+    f : (n, 3) forces, added to
 
     Returns
     -------
     energy : float
         Strain energy, J.
     n_bad : int
-        Segments of zero length (forces undefined, set to zero).
+        Segments of zero length (their forces are left out).
     """
     ns = rest_length.shape[0]
     energy = 0.0
     n_bad = 0
-    for e in numba.prange(ns):
+    for e in range(ns):
         d0 = x[e + 1, 0] - x[e, 0]
         d1 = x[e + 1, 1] - x[e, 1]
         d2 = x[e + 1, 2] - x[e, 2]
         l = math.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
         if not l > 0.0:
             n_bad += 1
-            for a in range(2):
-                for k in range(3):
-                    seg_f[e, a, k] = 0.0
             continue
         stretch = l - rest_length[e]
         energy += 0.5 * axial_k[e] * stretch * stretch
         tension = axial_k[e] * stretch / l
-        seg_f[e, 0, 0] = tension * d0
-        seg_f[e, 0, 1] = tension * d1
-        seg_f[e, 0, 2] = tension * d2
-        seg_f[e, 1, 0] = -tension * d0
-        seg_f[e, 1, 1] = -tension * d1
-        seg_f[e, 1, 2] = -tension * d2
+        f[e, 0] += tension * d0
+        f[e, 1] += tension * d1
+        f[e, 2] += tension * d2
+        f[e + 1, 0] -= tension * d0
+        f[e + 1, 1] -= tension * d1
+        f[e + 1, 2] -= tension * d2
     nv = bend_k.shape[0]
-    for v in numba.prange(nv):
+    for v in range(nv):
         phi, s, c, la, lb, a0, a1, a2, b0, b1, b2 = _turning(x, v, v + 1, v + 2)
         if not (la > 0.0 and lb > 0.0):
             n_bad += 1
-            for a in range(3):
-                for k in range(3):
-                    vert_f[v, a, k] = 0.0
             continue
         energy += 0.5 * bend_k[v] * phi * phi
         # dE/dt_a = -k phi/sin(phi) (t_b - c t_a); phi / sin(phi) -> 1 for a straight hinge.
@@ -114,19 +109,19 @@ def rod_kernel(x, rest_length, axial_k, bend_k, seg_f, vert_f):
         gb0 = q * (a0 - c * b0) / lb
         gb1 = q * (a1 - c * b1) / lb
         gb2 = q * (a2 - c * b2) / lb
-        vert_f[v, 0, 0] = ga0
-        vert_f[v, 0, 1] = ga1
-        vert_f[v, 0, 2] = ga2
-        vert_f[v, 1, 0] = gb0 - ga0
-        vert_f[v, 1, 1] = gb1 - ga1
-        vert_f[v, 1, 2] = gb2 - ga2
-        vert_f[v, 2, 0] = -gb0
-        vert_f[v, 2, 1] = -gb1
-        vert_f[v, 2, 2] = -gb2
+        f[v, 0] += ga0
+        f[v, 1] += ga1
+        f[v, 2] += ga2
+        f[v + 1, 0] += gb0 - ga0
+        f[v + 1, 1] += gb1 - ga1
+        f[v + 1, 2] += gb2 - ga2
+        f[v + 2, 0] -= gb0
+        f[v + 2, 1] -= gb1
+        f[v + 2, 2] -= gb2
     return energy, n_bad
 
 
-@numba.njit(parallel=True, cache=True)
+@numba.njit(cache=True)
 def rod_omega2_kernel(x, rest_length, axial_k, bend_k, mass, out):
     """Gershgorin bound of each node's row of M^-1 K (rad^2/s^2) into ``out`` (n,).
 
@@ -137,7 +132,7 @@ def rod_omega2_kernel(x, rest_length, axial_k, bend_k, mass, out):
     n = x.shape[0]
     ns = rest_length.shape[0]
     nv = bend_k.shape[0]
-    for i in numba.prange(n):
+    for i in range(n):
         row = 0.0
         for e in range(max(i - 1, 0), min(i + 1, ns)):
             d0 = x[e + 1, 0] - x[e, 0]
@@ -226,11 +221,6 @@ class Rod:
         self._lumped_mass[1:] += 0.5 * seg_mass
         self.mass = self._lumped_mass.copy()
 
-        hinges = np.column_stack((np.arange(n - 2), np.arange(1, n - 1), np.arange(2, n))).astype(np.int64)
-        self._seg_ptr, self._seg_slots = node_incidence(self.segments, n)
-        self._hinge_ptr, self._hinge_slots = node_incidence(hinges, n)
-        self._seg_buf = np.zeros((n - 1, 2, 3))
-        self._hinge_buf = np.zeros((n - 2, 3, 3))
         self._omega2 = np.zeros(n)
 
     @classmethod
@@ -270,16 +260,12 @@ class Rod:
     def internal_forces(self, x, f):
         """Add internal elastic forces (-dE/dx) for positions x into f (n, 3); return strain energy, J."""
         self._check_x(x)
-        energy, n_bad = rod_kernel(
-            x, self.rest_length, self.axial_stiffness, self.bending_stiffness, self._seg_buf, self._hinge_buf
-        )
+        energy, n_bad = rod_kernel(x, self.rest_length, self.axial_stiffness, self.bending_stiffness, f)
         if n_bad:
             raise ColonsimError(
                 f"{n_bad} segment(s) of rod '{self.name}' collapsed to zero length; the simulation diverged: "
                 "reduce the time step or the loading rate."
             )
-        gather(self._seg_buf, self._seg_ptr, self._seg_slots, f)
-        gather(self._hinge_buf, self._hinge_ptr, self._hinge_slots, f)
         return energy
 
     def axial_force(self, x):

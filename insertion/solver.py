@@ -30,23 +30,55 @@ from colonsim.errors import ColonsimError
 # ---------------------------------------------------------------------------------------------
 
 
+@numba.njit(cache=True, inline="always")
+def _velocity_node(i, v, f_int, f_con, f_ext, mass, fixed, alpha, dt, v_new, f_damp, reaction):
+    m = mass[i]
+    h = 0.5 * alpha * dt
+    for k in range(3):
+        ftot = f_int[i, k] + f_con[i, k] + f_ext[i, k]
+        vf = ((1.0 - h) * v[i, k] + dt * ftot / m) / (1.0 + h)
+        f_damp[i, k] = -alpha * m * 0.5 * (v[i, k] + vf)
+        if fixed[i]:
+            v_new[i, k] = 0.0
+            reaction[i, k] = -m * vf / dt
+        else:
+            v_new[i, k] = vf
+            reaction[i, k] = 0.0
+
+
 @numba.njit(parallel=True, cache=True)
 def velocity_kernel(v, f_int, f_con, f_ext, mass, fixed, alpha, dt, v_new, f_damp, reaction):
     """Damped velocity update into ``v_new``; fixed nodes get zero velocity and their reaction."""
-    n = v.shape[0]
-    h = 0.5 * alpha * dt
-    for i in numba.prange(n):
-        m = mass[i]
-        for k in range(3):
-            ftot = f_int[i, k] + f_con[i, k] + f_ext[i, k]
-            vf = ((1.0 - h) * v[i, k] + dt * ftot / m) / (1.0 + h)
-            f_damp[i, k] = -alpha * m * 0.5 * (v[i, k] + vf)
-            if fixed[i]:
-                v_new[i, k] = 0.0
-                reaction[i, k] = -m * vf / dt
-            else:
-                v_new[i, k] = vf
-                reaction[i, k] = 0.0
+    for i in numba.prange(v.shape[0]):
+        _velocity_node(i, v, f_int, f_con, f_ext, mass, fixed, alpha, dt, v_new, f_damp, reaction)
+
+
+@numba.njit(cache=True)
+def velocity_kernel_serial(v, f_int, f_con, f_ext, mass, fixed, alpha, dt, v_new, f_damp, reaction):
+    """Serial :func:`velocity_kernel` for bodies too small to pay for threads."""
+    for i in range(v.shape[0]):
+        _velocity_node(i, v, f_int, f_con, f_ext, mass, fixed, alpha, dt, v_new, f_damp, reaction)
+
+
+@numba.njit(cache=True, inline="always")
+def _advance_node(i, x, v, v_new, mass, f_int, f_con, f_ext, f_damp, reaction, dt):
+    w_int = 0.0
+    w_con = 0.0
+    w_ext = 0.0
+    w_damp = 0.0
+    w_react = 0.0
+    kinetic = 0.0
+    for k in range(3):
+        va = 0.5 * (v[i, k] + v_new[i, k])
+        w_int += f_int[i, k] * va
+        w_con += f_con[i, k] * va
+        w_ext += f_ext[i, k] * va
+        w_damp += f_damp[i, k] * va
+        w_react += reaction[i, k] * va
+        kinetic += 0.5 * mass[i] * va * va
+        x[i, k] += dt * v_new[i, k]
+        v[i, k] = v_new[i, k]
+    return w_int, w_con, w_ext, w_damp, w_react, kinetic
 
 
 @numba.njit(parallel=True, cache=True)
@@ -59,24 +91,40 @@ def advance_kernel(x, v, v_new, mass, f_int, f_con, f_ext, f_damp, reaction, dt_
         Work (J) done on the body during the step by each family, and the kinetic energy at the
         mid-step velocity (v_old + v_new) / 2.
     """
-    n = x.shape[0]
     w_int = 0.0
     w_con = 0.0
     w_ext = 0.0
     w_damp = 0.0
     w_react = 0.0
     kinetic = 0.0
-    for i in numba.prange(n):
-        for k in range(3):
-            va = 0.5 * (v[i, k] + v_new[i, k])
-            w_int += f_int[i, k] * va
-            w_con += f_con[i, k] * va
-            w_ext += f_ext[i, k] * va
-            w_damp += f_damp[i, k] * va
-            w_react += reaction[i, k] * va
-            kinetic += 0.5 * mass[i] * va * va
-            x[i, k] += dt * v_new[i, k]
-            v[i, k] = v_new[i, k]
+    for i in numba.prange(x.shape[0]):
+        a, b, c, d, e, k = _advance_node(i, x, v, v_new, mass, f_int, f_con, f_ext, f_damp, reaction, dt)
+        w_int += a
+        w_con += b
+        w_ext += c
+        w_damp += d
+        w_react += e
+        kinetic += k
+    return w_int * dt_mid, w_con * dt_mid, w_ext * dt_mid, w_damp * dt_mid, w_react * dt_mid, kinetic
+
+
+@numba.njit(cache=True)
+def advance_kernel_serial(x, v, v_new, mass, f_int, f_con, f_ext, f_damp, reaction, dt_mid, dt):
+    """Serial :func:`advance_kernel` for bodies too small to pay for threads."""
+    w_int = 0.0
+    w_con = 0.0
+    w_ext = 0.0
+    w_damp = 0.0
+    w_react = 0.0
+    kinetic = 0.0
+    for i in range(x.shape[0]):
+        a, b, c, d, e, k = _advance_node(i, x, v, v_new, mass, f_int, f_con, f_ext, f_damp, reaction, dt)
+        w_int += a
+        w_con += b
+        w_ext += c
+        w_damp += d
+        w_react += e
+        kinetic += k
     return w_int * dt_mid, w_con * dt_mid, w_ext * dt_mid, w_damp * dt_mid, w_react * dt_mid, kinetic
 
 
@@ -94,7 +142,9 @@ class _Windowed:
             nodes = np.arange(len(body.x0))
         self.nodes = np.unique(np.asarray(nodes, dtype=np.int64).ravel())
         if len(self.nodes) and (self.nodes.min() < 0 or self.nodes.max() >= len(body.x0)):
-            raise ColonsimError(f"constraint or load on body '{body.name}' names nodes that do not exist; fix the node list.")
+            raise ColonsimError(
+                f"constraint or load on body '{body.name}' names nodes that do not exist; fix the node list."
+            )
         if not end > start:
             raise ColonsimError(f"time window [{start}, {end}) is empty; give end > start.")
         self.start = float(start)
@@ -236,9 +286,11 @@ class NodalLoad(_Windowed):
 class _BodyState:
     """Positions, velocities and force/energy buffers of one body."""
 
-    def __init__(self, body, velocity):
+    def __init__(self, body, velocity, parallel_min_nodes):
         n = len(body.x0)
         self.body = body
+        # Nodal updates are a few flops per node: threads pay only for very large bodies.
+        self.parallel = n >= parallel_min_nodes
         self.x = np.ascontiguousarray(body.x0, dtype=np.float64).copy()
         self.v = np.zeros((n, 3)) if velocity is None else np.ascontiguousarray(velocity, dtype=np.float64).copy()
         if self.v.shape != (n, 3):
@@ -344,11 +396,14 @@ class ExplicitSolver:
         ``{body name: (n, 3) array}``, m/s.
     energy_growth_limit : float
         Divergence guard factor (see module docstring).
+    parallel_min_nodes : int
+        Bodies with at least this many nodes get threaded nodal updates (smaller ones run
+        serially: starting threads costs more than the work, and much more on a loaded machine).
     """
 
     def __init__(self, bodies, contacts=(), constraints=(), loads=(), damping=0.0, time_step=None,
                  time_step_factor=0.9, time_step_interval=100, mass_scaling=None, initial_velocity=None,
-                 energy_growth_limit=10.0):
+                 energy_growth_limit=10.0, parallel_min_nodes=50_000):
         names = [b.name for b in bodies]
         if len(set(names)) != len(names):
             raise ColonsimError(f"body names must be unique, got {names}; rename the bodies.")
@@ -362,7 +417,9 @@ class ExplicitSolver:
         self.loads = list(loads)
         for item in self.constraints + self.loads:
             if item.body not in self.bodies:
-                raise ColonsimError(f"a constraint or load acts on body '{item.body.name}', which is not in the solver.")
+                raise ColonsimError(
+                    f"a constraint or load acts on body '{item.body.name}', which is not in the solver; add the body."
+                )
         if isinstance(damping, dict):
             unknown = set(damping) - set(names)
             if unknown:
@@ -373,7 +430,7 @@ class ExplicitSolver:
         if any(a < 0.0 for a in self.damping.values()):
             raise ColonsimError("damping coefficients must be >= 0 1/s; fix them.")
         initial_velocity = initial_velocity or {}
-        self.state = {b.name: _BodyState(b, initial_velocity.get(b.name)) for b in self.bodies}
+        self.state = {b.name: _BodyState(b, initial_velocity.get(b.name), parallel_min_nodes) for b in self.bodies}
         self.fixed_time_step = time_step
         self.time_step_factor = float(time_step_factor)
         self.time_step_interval = int(time_step_interval)
@@ -463,8 +520,9 @@ class ExplicitSolver:
         self._refresh_fixed(t)
         for b in self.bodies:
             s = self.state[b.name]
-            velocity_kernel(s.v, s.f_int, s.f_con, s.f_ext, b.mass, s.fixed, self.damping[b.name], dt_mid,
-                            s.v_new, s.f_damp, s.reaction)
+            kernel = velocity_kernel if s.parallel else velocity_kernel_serial
+            kernel(s.v, s.f_int, s.f_con, s.f_ext, b.mass, s.fixed, self.damping[b.name], dt_mid, s.v_new, s.f_damp,
+                   s.reaction)
         t_mid = t + 0.5 * dt
         for c in self.constraints:
             if isinstance(c, FixedNodes):
@@ -481,7 +539,8 @@ class ExplicitSolver:
         work_in = 0.0
         for b in self.bodies:
             s = self.state[b.name]
-            w_int, w_con, w_ext, w_damp, w_react, kinetic = advance_kernel(
+            kernel = advance_kernel if s.parallel else advance_kernel_serial
+            w_int, w_con, w_ext, w_damp, w_react, kinetic = kernel(
                 s.x, s.v, s.v_new, b.mass, s.f_int, s.f_con, s.f_ext, s.f_damp, s.reaction, dt_mid, dt
             )
             s.kinetic = kinetic
