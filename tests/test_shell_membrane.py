@@ -11,6 +11,7 @@ from identification.uniaxial import nominal_stress
 from insertion.material import MooneyRivlin, REFERENCE_MATERIAL_PATH, load_material
 from insertion.sheet_mesh import flat_sheet
 from insertion.shell import Shell
+from insertion.statics import minimize_energy
 
 REFERENCE = load_material(REFERENCE_MATERIAL_PATH)
 MATERIALS = {
@@ -126,3 +127,30 @@ def test_inverted_triangle_is_reported():
     x[i] = x[shell.triangles[0, 1]]  # collapse a triangle onto an edge
     with pytest.raises(ColonsimError, match="inverted or collapsed"):
         _membrane(shell, x)
+
+
+def test_free_lateral_contraction_found_by_static_solve(serial_kernels):
+    """Grips that hold only the axial coordinate (sliding grips): the static solve must find the
+    homogeneous state by itself, lateral stretch 1/sqrt(l), and the closed-form grip force.
+    Tolerance 1e-5: the solve stops at nodal forces below 1e-7 of the grip force (near the
+    energy's round-off floor), which leaves the lateral stretch 1e-6 and the grip force 2e-7 off
+    (measured)."""
+    material = REFERENCE
+    shell = _sheet(material)
+    stretch = 1.4
+    grip = np.isclose(shell.x0[:, 0], LENGTH)
+    fixed = np.isclose(shell.x0[:, 0], 0.0)
+    free = np.ones(shell.x0.shape, dtype=bool)
+    free[grip | fixed, 0] = False
+    free[:, 2] = False  # in-plane problem
+    free[np.argmin(shell.x0[:, 0] + shell.x0[:, 1]), 1] = False  # no rigid sliding across
+    start = shell.x0.copy()
+    start[:, 0] = shell.x0[:, 0] * stretch
+    expected = nominal_stress(stretch, get_law("mooney_rivlin_3"), [material.C10, material.C01, material.C11])
+    expected *= WIDTH * THICKNESS
+    x, _ = minimize_energy(start, free, shell.membrane_forces, force_tol=1e-7 * expected)
+    assert np.ptp(x[:, 1]) / WIDTH == pytest.approx(stretch**-0.5, rel=1e-5)
+    assert np.allclose(x[:, 0], shell.x0[:, 0] * stretch, rtol=0, atol=1e-5 * LENGTH)
+    f = np.zeros_like(x)
+    shell.membrane_forces(x, f)
+    assert -f[grip, 0].sum() == pytest.approx(expected, rel=1e-5)
