@@ -1,0 +1,65 @@
+"""Scalar outcomes of an insertion from its time series (SPEC.md 2.3-2.4).
+
+Plain functions of recorded arrays, so they apply equally to a fresh run and to a CSV read back.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from scipy.signal import find_peaks
+
+
+def characteristic_points(time, depth, deformation, prominence=0.05):
+    """Points A, B, C of an RSJ deformation curve (SPEC.md 2.4).
+
+    A is the first maximum (the tip negotiating the angulation), B the minimum that follows, C
+    the maximum after B (the tip passing the fixed end). A maximum counts only if it stands out
+    by ``prominence`` times the curve's overall maximum, so recording noise is not taken for A.
+
+    Parameters
+    ----------
+    time, depth, deformation : (n,) arrays
+        Time (s), insertion depth (m) and colon deformation (m).
+
+    Returns
+    -------
+    dict with keys "A", "B", "C", each ``{"time_s", "depth_m", "deformation_m"}`` or None when
+    the curve has no such point (for instance a monotone curve has only C, its maximum).
+    """
+    t, z, u = (np.asarray(a, dtype=float) for a in (time, depth, deformation))
+    points = {"A": None, "B": None, "C": None}
+    if u.size < 3 or not np.all(np.isfinite(u)):
+        return points
+
+    def at(i):
+        return {"time_s": float(t[i]), "depth_m": float(z[i]), "deformation_m": float(u[i])}
+
+    scale = max(float(np.max(u)), 1e-12)
+    peaks, _ = find_peaks(u, prominence=prominence * scale)
+    if peaks.size:
+        a = int(peaks[0])
+        later = peaks[peaks > a]
+        # B: the lowest point between A and the next prominent rise (or the end of the run).
+        stop = int(later[0]) if later.size else u.size
+        b = a + int(np.argmin(u[a:stop]))
+        if b > a and u[b] < u[a]:
+            points["A"], points["B"] = at(a), at(b)
+            c = b + int(np.argmax(u[b:]))
+            if c > b:
+                points["C"] = at(c)
+            return points
+    points["C"] = at(int(np.argmax(u)))
+    return points
+
+
+def quasi_static_fraction(kinetic, internal, ratio=0.1, floor=1e-12):
+    """Fraction of recorded samples with kinetic / internal energy below ``ratio``.
+
+    Samples whose internal energy is below ``floor`` J (the very start, nothing deformed yet)
+    are left out: the ratio is meaningless there.
+    """
+    k, w = np.asarray(kinetic, dtype=float), np.asarray(internal, dtype=float)
+    keep = w > floor
+    if not np.any(keep):
+        return 0.0
+    return float(np.mean(k[keep] < ratio * w[keep]))
