@@ -72,3 +72,22 @@ def test_bad_geometry_and_unphysical_parameters():
         ClampedStripModel(L, W, 0.0)
     with pytest.raises(FEConvergenceError, match="shear modulus"):
         ClampedStripModel(L, W, T).solve([-1e4, 0.0, 0.0], D)
+
+
+def test_assembled_tangent_matches_finite_differences_of_the_residual():
+    """The global Newton matrix (free dofs) against central differences of the internal forces
+    at a stretched, sheared state: O(h^2) truncation, 1e-6 relative leaves room for round-off."""
+    m = ClampedStripModel(L, W, T, n_length=3, n_width=2)
+    rng = np.random.default_rng(5)
+    u = 3e-4 * rng.standard_normal(m.n_dofs)  # ~5 % strains on 8 mm elements, no inversion
+    _, K = m._residual_tangent(u, REFERENCE)
+    K = K.toarray()
+    h = 1e-7
+    free = m._free
+    numeric = np.empty_like(K)
+    for j, dof in enumerate(free):
+        e = np.zeros(m.n_dofs)
+        e[dof] = h
+        numeric[:, j] = (m._residual_tangent(u + e, REFERENCE, False)[0][free]
+                         - m._residual_tangent(u - e, REFERENCE, False)[0][free]) / (2 * h)
+    np.testing.assert_allclose(K, numeric, rtol=1e-6, atol=1e-6 * np.abs(K).max())
