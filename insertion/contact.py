@@ -18,9 +18,10 @@ so that the viscous friction stays stable in explicit time stepping. The reactio
 split linearly between the segment's two nodes.
 
 Broad phase: candidate (wall node, segment) pairs within radius + offset + skin, found with
-a uniform cell hash of the inflated segment boxes (sorted cell keys, binary search per wall
-node, parallel over wall nodes); rebuilt when the nodes have moved more than the skin since the
-last build, so the per-step cost scales with the number of candidates, not with all pairs.
+a uniform cell hash of the inflated segment boxes (sorted cell keys, one binary search per wall
+node); rebuilt only when the nodes have moved more than the skin since the last build, so the
+per-step cost scales with the number of candidates, not with all pairs. The narrow phase runs
+on threads for large candidate lists (``parallel_min_candidates``), serially otherwise.
 """
 
 import math
@@ -34,39 +35,29 @@ _OFF = 1 << 20
 _BASE = 1 << 21
 
 
-@numba.njit(cache=True, inline="always")
+@numba.njit(cache=True)
 def _cell_key(ix, iy, iz):
     return ((ix + _OFF) * _BASE + (iy + _OFF)) * _BASE + (iz + _OFF)
 
 
-@numba.njit(cache=True)
 def segment_cell_table(xr, seg, cutoff, cell):
-    """Sorted cell keys of the segments' inflated bounding boxes and the matching segment ids."""
-    ns = seg.shape[0]
-    lo = np.empty((ns, 3), dtype=np.int64)
-    hi = np.empty((ns, 3), dtype=np.int64)
-    total = 0
-    for s in range(ns):
-        a = seg[s, 0]
-        b = seg[s, 1]
-        m = 1
-        for k in range(3):
-            lo[s, k] = int(math.floor((min(xr[a, k], xr[b, k]) - cutoff) / cell))
-            hi[s, k] = int(math.floor((max(xr[a, k], xr[b, k]) + cutoff) / cell))
-            m *= hi[s, k] - lo[s, k] + 1
-        total += m
-    keys = np.empty(total, dtype=np.int64)
-    ids = np.empty(total, dtype=np.int64)
-    p = 0
-    for s in range(ns):
-        for ix in range(lo[s, 0], hi[s, 0] + 1):
-            for iy in range(lo[s, 1], hi[s, 1] + 1):
-                for iz in range(lo[s, 2], hi[s, 2] + 1):
-                    keys[p] = _cell_key(ix, iy, iz)
-                    ids[p] = s
-                    p += 1
-    order = np.argsort(keys, kind="mergesort")
-    return keys[order], ids[order]
+    """Sorted cell keys of the segments' inflated bounding boxes and the matching segment ids.
+
+    With ``cell`` at least the longest segment and twice ``cutoff``, a box spans at most three
+    cells per axis, so 27 offsets from its lower cell cover it (numpy: a rod has few segments).
+    """
+    a = xr[seg[:, 0]]
+    b = xr[seg[:, 1]]
+    lo = np.floor((np.minimum(a, b) - cutoff) / cell).astype(np.int64)
+    hi = np.floor((np.maximum(a, b) + cutoff) / cell).astype(np.int64)
+    off = np.stack(np.meshgrid(np.arange(3), np.arange(3), np.arange(3), indexing="ij"), axis=-1).reshape(-1, 3)
+    cells = lo[:, None, :] + off[None, :, :]
+    valid = np.all(cells <= hi[:, None, :], axis=2)
+    cells = cells[valid]
+    ids = np.broadcast_to(np.arange(len(seg), dtype=np.int64)[:, None], valid.shape)[valid]
+    keys = ((cells[:, 0] + _OFF) * _BASE + (cells[:, 1] + _OFF)) * _BASE + (cells[:, 2] + _OFF)
+    order = np.argsort(keys, kind="stable")
+    return np.ascontiguousarray(keys[order]), np.ascontiguousarray(ids[order])
 
 
 @numba.njit(cache=True, inline="always")
@@ -87,12 +78,15 @@ def _point_segment(xs, i, xr, a, b):
     return d0 * d0 + d1 * d1 + d2 * d2, t
 
 
-@numba.njit(parallel=True, cache=True)
+@numba.njit(cache=True)
 def candidate_counts(xs, xr, seg, keys, ids, cutoff, cell, counts):
-    """Number of segments within ``cutoff`` of each wall node, into ``counts``."""
+    """Number of segments within ``cutoff`` of each wall node, into ``counts``.
+
+    Serial: it runs only when the list is rebuilt (every few hundred steps) and costs a hash
+    lookup per wall node."""
     n = xs.shape[0]
     c2 = cutoff * cutoff
-    for i in numba.prange(n):
+    for i in range(n):
         key = _cell_key(int(math.floor(xs[i, 0] / cell)), int(math.floor(xs[i, 1] / cell)),
                         int(math.floor(xs[i, 2] / cell)))
         lo = np.searchsorted(keys, key, side="left")
@@ -106,11 +100,12 @@ def candidate_counts(xs, xr, seg, keys, ids, cutoff, cell, counts):
         counts[i] = m
 
 
-@numba.njit(parallel=True, cache=True)
+@numba.njit(cache=True)
 def candidate_fill(xs, xr, seg, keys, ids, cutoff, cell, nodes, ptr, out):
-    """Segment ids near each listed wall node into ``out[ptr[c]:ptr[c + 1]]``."""
+    """Segment ids near each listed wall node into ``out[ptr[c]:ptr[c + 1]]`` (serial, see
+    :func:`candidate_counts`)."""
     c2 = cutoff * cutoff
-    for c in numba.prange(nodes.shape[0]):
+    for c in range(nodes.shape[0]):
         i = nodes[c]
         key = _cell_key(int(math.floor(xs[i, 0] / cell)), int(math.floor(xs[i, 1] / cell)),
                         int(math.floor(xs[i, 2] / cell)))
@@ -137,7 +132,7 @@ def max_displacement(x, x_ref):
     return math.sqrt(worst)
 
 
-@numba.njit(cache=True, inline="always")
+@numba.njit(cache=True)
 def _contact_one(c, xs, vs, ms, fixed_s, xr, vr, mr, seg, nodes, ptr, cand, radius, offset, k, zeta, mu,
                  v_slip, dt, fs, rod_seg, rod_t, rod_f, damp_f, fric_f):
     """Contact of candidate wall node ``nodes[c]``: (energy, damping power, friction power,

@@ -30,7 +30,7 @@ from colonsim.errors import ColonsimError
 # ---------------------------------------------------------------------------------------------
 
 
-@numba.njit(cache=True, inline="always")
+@numba.njit(cache=True)
 def _velocity_node(i, v, f_int, f_con, f_ext, mass, fixed, alpha, dt, v_new, f_damp, reaction):
     m = mass[i]
     h = 0.5 * alpha * dt
@@ -60,7 +60,7 @@ def velocity_kernel_serial(v, f_int, f_con, f_ext, mass, fixed, alpha, dt, v_new
         _velocity_node(i, v, f_int, f_con, f_ext, mass, fixed, alpha, dt, v_new, f_damp, reaction)
 
 
-@numba.njit(cache=True, inline="always")
+@numba.njit(cache=True)
 def _advance_node(i, x, v, v_new, mass, f_int, f_con, f_ext, f_damp, reaction, dt):
     w_int = 0.0
     w_con = 0.0

@@ -100,3 +100,22 @@ class _State:
         self.v = np.zeros_like(self.x)
         self.f_con = np.zeros_like(self.x)
         self.fixed = np.zeros(len(self.x), dtype=np.uint8)
+
+
+def test_threaded_narrow_phase_matches_serial():
+    # Large contact sets run the narrow phase on threads; it must give the serial result
+    # (same arithmetic per candidate, only the order of the scalar sums differs: 1e-12).
+    wall, rod, contact, under = rod_on_sheet(friction=0.2)
+    xr = rod.x0.copy()
+    xr[:, 2] -= 1e-4  # press the rod into the wall
+    out = []
+    for threshold in (10**9, 0):
+        contact.parallel_min_candidates = threshold
+        state = {"scope": _State(rod), "wall": _State(wall)}
+        state["scope"].x[:] = xr
+        state["scope"].v[:, 0] = 0.01
+        contact.compute(state, 1e-6)
+        out.append((state["wall"].f_con.copy(), state["scope"].f_con.copy(), contact.energy))
+    assert np.allclose(out[0][0], out[1][0], rtol=0, atol=1e-12)
+    assert np.allclose(out[0][1], out[1][1], rtol=0, atol=1e-12)
+    assert out[0][2] == pytest.approx(out[1][2], rel=1e-12)

@@ -111,3 +111,12 @@ def test_axial_wave_speed_and_impedance():
             force.append(push.reaction[0])
     assert d / arrival == pytest.approx(c, rel=0.02)
     assert np.mean(force) == pytest.approx(RHO * c * rod.area * v0, rel=0.02)
+
+
+def test_hollow_section_properties():
+    # Annulus: A = pi (D^2 - d^2) / 4, I = pi (D^4 - d^4) / 64; lumped masses sum to rho A L.
+    rod = Rod.straight(0.5, D, E, RHO, spacing=5e-3, inner_diameter=4e-3)
+    assert rod.area == pytest.approx(math.pi / 4 * (D**2 - 4e-3**2), rel=1e-14)
+    assert rod.second_moment == pytest.approx(math.pi / 64 * (D**4 - 4e-3**4), rel=1e-14)
+    assert rod.mass.sum() == pytest.approx(RHO * rod.area * 0.5, rel=1e-12)
+    assert rod.radius == 0.5 * D and rod.tip_node == rod.n_nodes - 1
