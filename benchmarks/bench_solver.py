@@ -9,7 +9,7 @@ per-step time, element updates per second per core
 ((triangles + hinges + rod segments + contact candidates) * steps / wall / cores) and the
 projected wall time of a 0.5 s simulated push at the solver's time step.
 
-Run: ``python benchmarks/bench_solver.py [--steps 2000] [--threads 2] [--mesh 3e-3]``
+Run: ``python benchmarks/bench_solver.py [--steps 2000] [--threads 2] [--mesh 3e-3] [--rod-spacing 5e-3]``
 """
 
 import argparse
@@ -63,13 +63,14 @@ def main():
     parser.add_argument("--threads", type=int, default=None, help="Numba threads (default: all)")
     parser.add_argument("--push", type=float, default=0.5, help="simulated push duration to project, s")
     parser.add_argument("--mesh", type=float, default=3e-3, help="wall triangle size, m")
+    parser.add_argument("--rod-spacing", type=float, default=5e-3, help="scope node spacing, m")
     args = parser.parse_args()
     if args.threads:
         numba.set_num_threads(args.threads)
     cores = numba.get_num_threads()
 
     t0 = time.perf_counter()
-    sim, colon, scope, contact = build(mesh_size=args.mesh)
+    sim, colon, scope, contact = build(mesh_size=args.mesh, rod_spacing=args.rod_spacing)
     for _ in range(20):  # compile and build the candidate list
         sim.advance()
     warm = time.perf_counter() - t0
@@ -101,7 +102,10 @@ def main():
     print(f"model: {len(colon.triangles)} triangles, {len(colon.hinges)} hinges, {len(scope.segments)} rod segments, "
           f"{contact.n_candidates} contact candidates ({contact.n_active} in contact), {cores} thread(s)")
     print(f"warm-up (compile + first steps): {warm:.1f} s")
-    print(f"time step: {sim.dt:.3e} s  ->  {steps_push:.0f} steps for a {args.push} s push")
+    limits = {b.name: b.critical_time_step(sim.state[b.name].x) for b in sim.bodies}
+    limits["contact"] = contact.critical_time_step()
+    print(f"time step: {sim.dt:.3e} s  ->  {steps_push:.0f} steps for a {args.push} s push "
+          f"(stable steps alone: " + ", ".join(f"{k} {v:.2e} s" for k, v in limits.items()) + ")")
     print(f"per step: {per_step * 1e3:.3f} ms over {args.steps} steps (simulated {sim.time:.4f} s); "
           f"wall internal forces ~{100 * shell_share:.0f} % of it")
     print(f"element updates per second per core: {updates / 1e6:.1f} M")

@@ -132,7 +132,7 @@ def max_displacement(x, x_ref):
     return math.sqrt(worst)
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, inline="always")  # a call per node would cost more than its work
 def _contact_one(c, xs, vs, ms, fixed_s, xr, vr, mr, seg, nodes, ptr, cand, radius, offset, k, zeta, mu,
                  v_slip, dt, fs, rod_seg, rod_t, rod_f, damp_f, fric_f):
     """Contact of candidate wall node ``nodes[c]``: (energy, damping power, friction power,

@@ -30,17 +30,20 @@ from colonsim.errors import ColonsimError
 # ---------------------------------------------------------------------------------------------
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, inline="always")  # a call per node would cost more than its work
 def _velocity_node(i, v, f_int, f_con, f_ext, mass, fixed, alpha, dt, v_new, f_damp, reaction):
+    # one division per node: divisions dominate this otherwise memory-bound loop
     m = mass[i]
     h = 0.5 * alpha * dt
+    keep = (1.0 - h) / (1.0 + h)
+    gain = dt / (m * (1.0 + h))
     for k in range(3):
         ftot = f_int[i, k] + f_con[i, k] + f_ext[i, k]
-        vf = ((1.0 - h) * v[i, k] + dt * ftot / m) / (1.0 + h)
-        f_damp[i, k] = -alpha * m * 0.5 * (v[i, k] + vf)
+        vf = keep * v[i, k] + gain * ftot
+        f_damp[i, k] = -0.5 * alpha * m * (v[i, k] + vf)
         if fixed[i]:
             v_new[i, k] = 0.0
-            reaction[i, k] = -m * vf / dt
+            reaction[i, k] = -vf * (m / dt)
         else:
             v_new[i, k] = vf
             reaction[i, k] = 0.0
@@ -60,7 +63,7 @@ def velocity_kernel_serial(v, f_int, f_con, f_ext, mass, fixed, alpha, dt, v_new
         _velocity_node(i, v, f_int, f_con, f_ext, mass, fixed, alpha, dt, v_new, f_damp, reaction)
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, inline="always")  # a call per node would cost more than its work
 def _advance_node(i, x, v, v_new, mass, f_int, f_con, f_ext, f_damp, reaction, dt):
     w_int = 0.0
     w_con = 0.0
