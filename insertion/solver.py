@@ -16,6 +16,33 @@ the contact objects.
 Divergence guard: a non-finite state, or mechanical energy growing beyond ``energy_growth_limit``
 times (initial energy + absolute work put in), stops the run with a :class:`ColonsimError` naming
 the time, the step and the remedy.
+
+Example (run by the test suite)::
+
+    import numpy as np
+    from insertion.contact import RodShellContact
+    from insertion.material import REFERENCE_MATERIAL_PATH, load_material
+    from insertion.rod import Rod
+    from insertion.sheet_mesh import straight_tube
+    from insertion.shell import Shell
+    from insertion.solver import ExplicitSolver, FixedNodes, LineConstraint, PrescribedVelocity
+
+    nodes, tri, ring = straight_tube(0.1, 0.038, 6e-3)  # mid-surface diameter = lumen + wall
+    colon = Shell(nodes, tri, 2e-3, load_material(REFERENCE_MATERIAL_PATH), name="colon")
+    scope = Rod.straight(0.15, 12.8e-3, 16e6, 2944.0, spacing=5e-3, start=(-0.1, 0.0, -0.01))
+    sim = ExplicitSolver(
+        [scope, colon],
+        contacts=[RodShellContact(scope, colon, friction=0.1)],
+        constraints=[
+            FixedNodes(colon, np.flatnonzero((ring == 0) | (ring == ring.max()))),
+            PrescribedVelocity(scope, [0], (0.6, 0.0, 0.0), ramp=2e-3),  # push, m/s
+            LineConstraint(scope, (-0.1, 0.0, -0.01), (1.0, 0.0, 0.0), extent=(-1.0, 0.09)),  # sheath
+        ],
+        damping=20.0,  # 1/s, mass-proportional
+    )
+    history = sim.run(5e-3, record_interval=1e-3, record_positions=["colon"])
+    push_force = history.reactions[1][:, 0]  # N, force the driver applies to the proximal end
+    contact_force = history.contacts[0]["normal_force"]  # N
 """
 
 import math
@@ -497,14 +524,14 @@ class ExplicitSolver:
             f"reduce time_step_factor (now {self.time_step_factor}) or the time step, or add damping."
         )
 
-    def advance(self):
-        """Advance the state by one time step."""
+    def advance(self, max_step=math.inf):
+        """Advance the state by one time step (at most ``max_step`` seconds)."""
         if self.dt is None or (self.fixed_time_step is None and self.step % self.time_step_interval == 0):
             try:
                 self._update_time_step()
             except ColonsimError as err:
                 raise self._diverged(str(err)) from err
-        dt = self.dt
+        dt = min(self.dt, max_step)
         dt_mid = dt if self._dt_prev is None else 0.5 * (dt + self._dt_prev)
         t = self.time
         try:
@@ -616,9 +643,9 @@ class ExplicitSolver:
         history = History()
         t_end = self.time + duration
         next_record = self.time
-        # Stop within a hair of t_end so float round-off does not add a step.
+        # The last step is shortened to end on t_end (central differences allow a varying step).
         while t_end - self.time > 1e-6 * (self.dt or 0.0):
-            self.advance()
+            self.advance(max_step=t_end - self.time)
             if record_interval is None or self.time >= next_record - 1e-12:
                 history._append(self._row(positions))
                 for cb in callbacks:
