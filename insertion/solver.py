@@ -164,7 +164,12 @@ def advance_kernel_serial(x, v, v_new, mass, f_int, f_con, f_ext, f_damp, reacti
 
 
 class _Windowed:
-    """Active on the time window [start, end)."""
+    """Active on the time window [start, end).
+
+    ``reaction`` holds the total force (N) the constraint applied to its nodes during the last
+    step (for a pushed end: the push force). Fixed nodes are imposed first, then the other
+    constraints in the solver's list order, each on the velocities left by the previous ones.
+    """
 
     def _init_window(self, body, nodes, start, end):
         self.body = body
