@@ -69,5 +69,6 @@ def test_damped_pushed_rod_energy_balance():
     # fixed node takes over the reaction
     assert np.any(np.abs(hist.reactions[0][:, 0]) > 0.0)
     assert np.all(hist.reactions[0][hist.time > 8.5e-3] == 0.0)
-    # the pushed node moved by the integral of the ramped velocity: 0.5 (8 ms - 1 ms)
-    assert sim.state["scope"].x[0, 0] == pytest.approx(0.5 * (8e-3 - 1e-3), rel=2e-3)
+    # the pushed node moved by the integral of the ramped velocity, 0.5 (8 ms - 1 ms), up to the
+    # one step in which the window ends
+    assert sim.state["scope"].x[0, 0] == pytest.approx(0.5 * (8e-3 - 1e-3), abs=0.5 * sim.dt)
