@@ -158,6 +158,30 @@ def advance_kernel_serial(x, v, v_new, mass, f_int, f_con, f_ext, f_damp, reacti
     return w_int * dt_mid, w_con * dt_mid, w_ext * dt_mid, w_damp * dt_mid, w_react * dt_mid, kinetic
 
 
+@numba.njit(cache=True)
+def line_constraint_kernel(x, v_new, reaction, mass, nodes, point, direction, s_min, s_max, dt):
+    """Remove the velocity across the line on the listed nodes lying within [s_min, s_max] along
+    it; add the reaction impulse / dt. Returns the total reaction force (3,)."""
+    total = np.zeros(3)
+    for j in range(nodes.shape[0]):
+        i = nodes[j]
+        s = 0.0
+        for k in range(3):
+            s += (x[i, k] - point[k]) * direction[k]
+        if s < s_min or s > s_max:
+            continue
+        along = 0.0
+        for k in range(3):
+            along += v_new[i, k] * direction[k]
+        for k in range(3):
+            vc = along * direction[k]
+            r = mass[i] * (vc - v_new[i, k]) / dt
+            reaction[i, k] += r
+            total[k] += r
+            v_new[i, k] = vc
+    return total
+
+
 # ---------------------------------------------------------------------------------------------
 # Constraints and loads
 # ---------------------------------------------------------------------------------------------
@@ -274,17 +298,8 @@ class LineConstraint(_Windowed):
         self.extent = (float(extent[0]), float(extent[1]))
 
     def apply(self, x, v_new, reaction, mass, dt_mid):
-        idx = self.nodes
-        s = (x[idx] - self.point) @ self.direction
-        idx = idx[(s >= self.extent[0]) & (s <= self.extent[1])]
-        if len(idx) == 0:
-            return np.zeros(3)
-        vn = v_new[idx]
-        vc = np.outer(vn @ self.direction, self.direction)
-        r = mass[idx, None] * (vc - vn) / dt_mid
-        reaction[idx] += r
-        v_new[idx] = vc
-        return r.sum(axis=0)
+        return line_constraint_kernel(x, v_new, reaction, mass, self.nodes, self.point, self.direction,
+                                      self.extent[0], self.extent[1], dt_mid)
 
 
 class NodalLoad(_Windowed):
