@@ -10,7 +10,7 @@ from insertion.material import REFERENCE_MATERIAL_PATH, load_material
 from insertion.rod import Rod
 from insertion.sheet_mesh import flat_sheet, straight_tube
 from insertion.shell import Shell
-from insertion.solver import ExplicitSolver, FixedNodes, NodalLoad
+from insertion.solver import ExplicitSolver, FixedNodes, LineConstraint, NodalLoad
 
 E = 16e6
 RHO = 2944.0
@@ -119,3 +119,28 @@ def test_threaded_narrow_phase_matches_serial():
     assert np.allclose(out[0][0], out[1][0], rtol=0, atol=1e-12)
     assert np.allclose(out[0][1], out[1][1], rtol=0, atol=1e-12)
     assert out[0][2] == pytest.approx(out[1][2], rel=1e-12)
+
+
+def test_hemispherical_tip_pressed_on_a_node_penetrates_f_over_k():
+    # A short rod standing tip-down over one wall node, guided along its axis (a sheath over
+    # its whole length) and pushed with F: only the node under the tip touches (its neighbours,
+    # 5 mm aside, are 1.5 mm clear of the 7.4 mm sphere), so the tip sinks F / k into it.
+    # Tolerance 0.5 %: relaxation residual of the critically damped contact spring.
+    nodes, tri = flat_sheet(0.1, 0.04, 5e-3)
+    wall = Shell(nodes, tri, T, load_material(REFERENCE_MATERIAL_PATH), name="wall")
+    below = int(np.argmin(np.hypot(nodes[:, 0] - 0.05, nodes[:, 1] - 0.04 * 4 / 9)))
+    reach = 0.5 * D + 0.5 * T
+    top = nodes[below] + (0.0, 0.0, reach + 0.03)
+    rod = Rod.straight(0.03, D, E, RHO, spacing=5e-3, start=top, direction=(0.0, 0.0, -1.0))
+    contact = RodShellContact(rod, wall, damping_ratio=1.0)
+    F = 0.2
+    sim = ExplicitSolver(
+        [rod, wall], contacts=[contact],
+        constraints=[FixedNodes(wall, np.arange(wall.n_nodes)), LineConstraint(rod, top, (0.0, 0.0, -1.0))],
+        loads=[NodalLoad(rod, [0], (0.0, 0.0, -F))],
+    )
+    omega = math.sqrt(contact.stiffness / rod.mass.sum())
+    sim.run(30.0 / omega, record_interval=1.0 / omega)
+    assert contact.n_active == 1
+    tip = sim.state["scope"].x[rod.tip_node]
+    assert reach - (tip[2] - nodes[below, 2]) == pytest.approx(F / contact.stiffness, rel=0.005)
