@@ -1,0 +1,117 @@
+"""The insertion manoeuvre (SPEC.md 2.3): a smooth push-speed profile and its phases.
+
+The proximal end of the scope is driven at a prescribed speed along the sheath axis. The speed
+profile is piecewise constant with (1 - cos) transitions of duration ``ramp`` between levels, so
+the scope is never jerked (a step in speed launches an axial wave of amplitude rho c A dv).
+
+- RSJ: one continuous push.
+- RSF, THF (**assumption** on the exact profile, as SPEC.md states): push with the mobile part's
+  lateral motion constrained until the tip reaches the flexure ("straighten"), slow to a stop and
+  let the system relax while the constraint is released ("birth and death"), then push through.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from colonsim.errors import ColonsimError
+
+
+@dataclass(frozen=True)
+class Phase:
+    """One phase of the manoeuvre: a time window, s, and the push speed at its plateau, m/s."""
+
+    name: str
+    start: float
+    end: float
+    speed: float
+    lateral_constraint: bool = False
+
+
+def _transition(tau, ramp):
+    """Smooth 0 -> 1 over [0, ramp] ((1 - cos) / 2) and its integral."""
+    if tau <= 0.0:
+        return 0.0, 0.0
+    if tau >= ramp:
+        return 1.0, tau - 0.5 * ramp
+    w = math.pi / ramp
+    return 0.5 * (1.0 - math.cos(w * tau)), 0.5 * (tau - math.sin(w * tau) / w)
+
+
+@dataclass
+class PushProfile:
+    """Push speed against time built from phases; speed changes take ``ramp`` seconds.
+
+    Each phase's speed is reached ``ramp`` after its start (a change starts at the phase start).
+    """
+
+    phases: list
+    ramp: float
+    _levels: list = field(init=False, repr=False)
+
+    def __post_init__(self):
+        if self.ramp < 0:
+            raise ColonsimError(f"ramp = {self.ramp} s must be >= 0")
+        self._levels = []
+        previous = 0.0
+        for p in self.phases:
+            self._levels.append((p.start, p.speed - previous))
+            previous = p.speed
+
+    @property
+    def duration(self):
+        return self.phases[-1].end
+
+    def speed(self, t):
+        """Push speed at time ``t``, m/s."""
+        return sum(dv * _transition(t - t0, self.ramp)[0] for t0, dv in self._levels)
+
+    def depth(self, t):
+        """Insertion depth (distance pushed) at time ``t``, m."""
+        return sum(dv * _transition(t - t0, self.ramp)[1] for t0, dv in self._levels)
+
+    def phase_at(self, t):
+        for p in self.phases:
+            if p.start <= t < p.end:
+                return p
+        return self.phases[-1]
+
+
+def _time_to_push(distance, speed, ramp):
+    """Time for a push from rest to cover ``distance`` (the ramp covers speed * ramp / 2)."""
+    return 0.5 * ramp + distance / speed
+
+
+def continuous_push(depth, speed=0.6, ramp=0.05) -> PushProfile:
+    """RSJ: push from rest to ``depth`` (m) at ``speed`` (m/s), starting with a ramp (s)."""
+    _check(depth, speed, ramp)
+    return PushProfile([Phase("push", 0.0, _time_to_push(depth, speed, ramp), speed)], ramp)
+
+
+def straighten_relax_push(straighten_depth, depth, speed=0.6, ramp=0.05, relax=0.1) -> PushProfile:
+    """RSF/THF: push to ``straighten_depth`` with the lateral constraint, stop and relax for
+    ``relax`` seconds with the constraint released, then push on to ``depth`` (m)."""
+    _check(depth, speed, ramp)
+    if not 0.0 < straighten_depth < depth:
+        raise ColonsimError(f"straightening depth {straighten_depth:.3g} m must lie between 0 and the total depth {depth:.3g} m")
+    if relax < ramp:
+        raise ColonsimError(f"relax time {relax} s must be at least the ramp {ramp} s (the scope must come to rest)")
+    # Slowing down from the plateau covers speed * ramp / 2, like speeding up.
+    t1 = _time_to_push(straighten_depth, speed, ramp) - 0.5 * ramp
+    t2 = t1 + relax
+    t3 = t2 + _time_to_push(depth - straighten_depth, speed, ramp)
+    return PushProfile([Phase("straighten", 0.0, t1, speed, lateral_constraint=True),
+                        Phase("relax", t1, t2, 0.0),
+                        Phase("push", t2, t3, speed)], ramp)
+
+
+def _check(depth, speed, ramp):
+    if not (np.isfinite(depth) and depth > 0):
+        raise ColonsimError(f"insertion depth {depth!r} m must be positive")
+    if not (np.isfinite(speed) and 0 < speed <= 5.0):
+        raise ColonsimError(f"push speed {speed!r} m/s must lie in (0, 5] (the source pushed at 0.6 m/s)")
+    if not (np.isfinite(ramp) and ramp >= 0):
+        raise ColonsimError(f"ramp {ramp!r} s must be >= 0")
