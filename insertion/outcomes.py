@@ -63,3 +63,18 @@ def quasi_static_fraction(kinetic, internal, ratio=0.1, floor=1e-12):
     if not np.any(keep):
         return 0.0
     return float(np.mean(k[keep] < ratio * w[keep]))
+
+
+def principal_stretches(x, triangles, dm_inv):
+    """Largest in-plane principal stretch of every triangle at positions ``x`` (n, 3), m.
+
+    F = [x1 - x0, x2 - x0] Dm^-1 maps the reference plane into space (3 x 2); the stretches are
+    the square roots of the eigenvalues of C = F^T F (closed form for 2 x 2).
+    """
+    p = x[triangles]
+    E = np.stack([p[:, 1] - p[:, 0], p[:, 2] - p[:, 0]], axis=2)  # (nt, 3, 2)
+    F = E @ dm_inv
+    C = np.einsum("tki,tkj->tij", F, F)
+    half_trace = 0.5 * (C[:, 0, 0] + C[:, 1, 1])
+    det = C[:, 0, 0] * C[:, 1, 1] - C[:, 0, 1] * C[:, 1, 0]
+    return np.sqrt(half_trace + np.sqrt(np.maximum(half_trace**2 - det, 0.0)))

@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from insertion.outcomes import characteristic_points, quasi_static_fraction
+from insertion.outcomes import characteristic_points, principal_stretches, quasi_static_fraction
 
 
 def rsj_like(noise=0.0, seed=0):
@@ -42,3 +42,16 @@ def test_quasi_static_fraction():
     kinetic = np.r_[0.5, 0.01, 0.01, 0.01, 0.01, 0.01, 0.01, 0.01, 0.5, 0.5]
     # the first sample (no strain energy yet) is left out: 7 of the 9 others are below 10 %
     assert quasi_static_fraction(kinetic, internal) == pytest.approx(7 / 9)
+
+
+def test_principal_stretch_of_a_stretched_and_rotated_triangle():
+    from insertion.shell import reference_frames
+
+    nodes = np.array([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]])
+    tri = np.array([[0, 1, 2]])
+    dm_inv, _ = reference_frames(nodes, tri)
+    stretch = np.diag([1.3, 0.9, 1.0])  # 1.3 along x, 0.9 along y
+    c, s = np.cos(0.7), np.sin(0.7)
+    rotation = np.array([[1, 0, 0], [0, c, -s], [0, s, c]])
+    x = nodes @ stretch.T @ rotation.T
+    assert principal_stretches(x, tri, dm_inv)[0] == pytest.approx(1.3, rel=1e-12)
