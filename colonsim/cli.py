@@ -200,6 +200,93 @@ def cmd_demo(args):
           "The demo will run them as they land.")
 
 
+def _add_insert(sub):
+    p = sub.add_parser("insert", help="simulate a colonoscope insertion (explicit dynamics)",
+                       description="Push a colonoscope through a colon model (SPEC.md 2) and record the colon "
+                                   "deformation, contact and push forces, tip motion and energies. Writes "
+                                   "timeseries.csv, summary.json and insertion.png per scope, a comparison table "
+                                   "and figure, and optional VTU files for ParaView.")
+    p.add_argument("--segment", default="rsj", help="rsj (default), rsf, thf, thf-fixed, or straight (sanity case)")
+    p.add_argument("--scope", nargs="+", default=["sdc"], help="utc, pdc, sdc or an outer diameter in mm; several allowed")
+    p.add_argument("--diameter", type=float, default=36.0, help="colon inner diameter, mm (default 36)")
+    p.add_argument("--angle", type=float, default=0.0, help="alpha (RSF) or beta (THF), degrees (default 0)")
+    p.add_argument("--friction", type=float, default=0.0, help="Coulomb friction scope/wall (default 0)")
+    p.add_argument("--wall-thickness", type=float, default=2.0, help="colon wall thickness, mm (default 2, an assumption)")
+    p.add_argument("--element-size", type=float, default=3.0, help="wall triangle size, mm (default 3)")
+    p.add_argument("--material", help="material JSON from colonsim calibrate (default: the source's parameters)")
+    p.add_argument("--vtu", action="store_true", help="write deformed meshes for ParaView (needs meshio)")
+    p.add_argument("--snapshot-every", type=float, default=0.02, help="simulated seconds between VTU snapshots")
+    p.add_argument("--out", type=Path, default=Path("colonsim_results/insertion"), help="output folder")
+    p.add_argument("--no-progress", action="store_true", help="no progress bar")
+    p.set_defaults(func=cmd_insert)
+
+
+def run_insertions(cases, out: Path, vtu=False, snapshot_every=0.02, show=True):
+    """Run each case, write its folder under ``out`` and a comparison; return the results."""
+    from tqdm import tqdm
+
+    from insertion.results import insertion_figure, write_insertion
+    from insertion.scenario import run_insertion
+    from colonsim.files import save_figure, write_csv
+    import pandas as pd
+
+    for case in cases:
+        case.validate()  # all inputs checked before the first (long) run starts
+    results = []
+    for case in cases:
+        bar = tqdm(total=1000, unit="mm", disable=None if show else True, dynamic_ncols=True, leave=False,
+                   mininterval=0.5, desc=f"{case.segment} {case.scope}")
+
+        def progress(depth, total, bar=bar):
+            bar.total = round(total * 1e3)
+            bar.n = min(round(depth * 1e3), bar.total)
+            bar.refresh()
+
+        try:
+            r = run_insertion(case, progress=progress, snapshot_interval=snapshot_every if vtu else None)
+        finally:
+            bar.close()
+        folder = out / f"{case.segment}_{r.summary['scope']['name'].replace(' ', '')}"
+        write_insertion(r, folder, vtu=vtu)
+        results.append(r)
+        s = r.summary
+        pts = ", ".join(f"{k} {v['deformation_cm']:.2f} cm" for k, v in s["points_cm"].items() if v is not None)
+        print(f"{case.segment.upper()} {s['scope']['name']:>8}: final deformation {s['final_deformation_cm']:.2f} cm, "
+              f"max {s['max_deformation_cm']:.2f} cm ({pts}); peak contact {s['peak_contact_force_N']:.2f} N, "
+              f"peak push {s['peak_push_force_N']:.2f} N; quasi-static {'holds' if s['quasi_static']['holds'] else 'does NOT hold'} "
+              f"(KE/IE < 10 %: colon {100 * s['quasi_static']['fraction_below_10pct']['colon']:.0f} %, "
+              f"scope {100 * s['quasi_static']['fraction_below_10pct']['scope']:.0f} % of samples); "
+              f"{s['steps']} steps in {s['wall_time_s']:.1f} s -> {folder}/")
+    table = pd.DataFrame([{"segment": r.case.segment, "scope": r.summary["scope"]["name"],
+                           "scope_diameter_mm": r.summary["scope"]["diameter_mm"], "colon_diameter_mm": r.case.diameter_mm,
+                           "angle_deg": r.case.angle_deg, "friction": r.case.friction,
+                           "final_deformation_cm": r.summary["final_deformation_cm"],
+                           "max_deformation_cm": r.summary["max_deformation_cm"],
+                           **{f"point_{k}_cm": (None if v is None else v["deformation_cm"]) for k, v in r.summary["points_cm"].items()},
+                           "peak_contact_force_N": r.summary["peak_contact_force_N"],
+                           "peak_push_force_N": r.summary["peak_push_force_N"],
+                           "max_wall_stretch": r.summary["max_wall_stretch"],
+                           "quasi_static": r.summary["quasi_static"]["holds"], "wall_time_s": r.summary["wall_time_s"]}
+                          for r in results])
+    write_csv(out / "comparison.csv", table)
+    save_figure(insertion_figure(results), out / "comparison.png")
+    print(f"comparison: {out}/comparison.csv, {out}/comparison.png")
+    return results
+
+
+def cmd_insert(args):
+    from insertion.scenario import InsertionCase
+
+    cases = [InsertionCase(segment=args.segment, scope=scope, diameter_mm=args.diameter, angle_deg=args.angle,
+                           friction=args.friction, wall_thickness_mm=args.wall_thickness,
+                           element_size_mm=args.element_size, material=args.material) for scope in args.scope]
+    if args.material is not None:
+        from insertion.material import load_material
+
+        load_material(args.material)
+    run_insertions(cases, args.out, vtu=args.vtu, snapshot_every=args.snapshot_every, show=not args.no_progress)
+
+
 def build_parser():
     from colonsim import __version__
 
@@ -207,6 +294,7 @@ def build_parser():
     parser.add_argument("--version", action="version", version=f"colonsim {__version__}")
     sub = parser.add_subparsers(dest="command", required=True)
     _add_calibrate(sub)
+    _add_insert(sub)
     demo = sub.add_parser("demo", help="run the workflows on the bundled data (a few minutes on 2 cores)")
     demo.add_argument("--out", type=Path, default=Path("colonsim_demo"), help="output folder (default colonsim_demo)")
     demo.add_argument("--no-progress", action="store_true", help="no progress bar")

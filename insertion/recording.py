@@ -1,0 +1,69 @@
+"""What an insertion records at every sample (SPEC.md 2.4), as a solver callback.
+
+Columns (SI): time_s, depth_m (pushed distance), deformation_m (largest nodal displacement of
+the mobile colon part), max_stretch (largest in-plane principal stretch of the wall), tip_displacement_m,
+tip_arc_m (tip position along the centerline), contact_force_N (sum of normal contact forces),
+push_force_N (drive reaction along the sheath axis), contact_nodes, kinetic/internal energy
+of each body (J), contact_energy_J, dt_s, step.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+
+from insertion.outcomes import principal_stretches
+
+
+class InsertionRecorder:
+    """Solver callback collecting one row per recorded sample (and optional snapshots)."""
+
+    def __init__(self, model, snapshot_interval=None):
+        self.model = model
+        self.rows = []
+        self.snapshots = []  # (time, colon positions, scope positions)
+        self.snapshot_interval = snapshot_interval
+        self._next_snapshot = 0.0
+        g = model.geometry
+        self._mobile = model.mobile_nodes
+        self._tip = model.rod.tip_node
+        self._tip0 = model.rod.x0[self._tip].copy()
+        s = np.linspace(0.0, g.centerline_length, max(200, int(g.centerline_length / 1e-3)))
+        self._arc = s
+        self._arc_points = np.asarray(g.centerline_points(s))
+
+    def __call__(self, solver):
+        m = self.model
+        colon = solver.state["colon"]
+        scope = solver.state[m.rod.name]
+        if self._mobile.size:
+            deformation = float(np.sqrt(((colon.x[self._mobile] - m.shell.x0[self._mobile]) ** 2).sum(axis=1).max()))
+        else:
+            deformation = 0.0
+        tip = scope.x[self._tip]
+        row = {
+            "time_s": solver.time,
+            "step": solver.step,
+            "dt_s": solver.dt,
+            "depth_m": m.push.depth(solver.time),
+            "deformation_m": deformation,
+            "max_stretch": float(principal_stretches(colon.x, m.shell.triangles, m.shell.dm_inv).max()),
+            "tip_displacement_m": float(np.linalg.norm(tip - self._tip0)),
+            "tip_arc_m": float(self._arc[np.argmin(((self._arc_points - tip) ** 2).sum(axis=1))]),
+            "contact_force_N": float(m.contact.normal_force),
+            "contact_nodes": int(m.contact.n_active),
+            "push_force_N": float(np.dot(m.drive.reaction, m.entry_axis)),
+            "kinetic_colon_J": colon.kinetic,
+            "internal_colon_J": colon.internal,
+            "kinetic_scope_J": scope.kinetic,
+            "internal_scope_J": scope.internal,
+            "contact_energy_J": float(m.contact.energy),
+            "phase": m.push.phase_at(solver.time).name,
+        }
+        self.rows.append(row)
+        if self.snapshot_interval is not None and solver.time >= self._next_snapshot - 1e-12:
+            self.snapshots.append((solver.time, colon.x.copy(), scope.x.copy()))
+            self._next_snapshot += self.snapshot_interval
+
+    def frame(self) -> pd.DataFrame:
+        return pd.DataFrame(self.rows)

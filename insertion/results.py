@@ -1,0 +1,108 @@
+"""Files of an insertion run: time series CSV (cm, N, J at the edge), summary JSON, figures, VTU.
+
+Layout of a run folder::
+
+    timeseries.csv   time [s], depth [cm], deformation [cm], max wall stretch, tip displacement [cm],
+                     contact and push force [N], kinetic/internal energy per body [J], ...
+    summary.json     final/max deformation, points A/B/C, peak forces, quasi-static check, inputs
+    insertion.png    deformation vs depth, forces, energy ratio, tip displacement
+    vtu/             colon_NNNN.vtu, scope_NNNN.vtu (+ .pvd collections) with --vtu
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+from matplotlib.figure import Figure
+
+from colonsim.files import atomic_path, save_figure, write_csv, write_json
+
+
+def user_units(ts: pd.DataFrame) -> pd.DataFrame:
+    """The recorded SI columns in the units people read: cm for lengths."""
+    out = pd.DataFrame({"time_s": ts["time_s"], "phase": ts["phase"], "depth_cm": ts["depth_m"] * 100,
+                        "deformation_cm": ts["deformation_m"] * 100, "max_wall_stretch": ts["max_stretch"],
+                        "tip_displacement_cm": ts["tip_displacement_m"] * 100, "tip_arc_cm": ts["tip_arc_m"] * 100,
+                        "contact_force_N": ts["contact_force_N"], "push_force_N": ts["push_force_N"],
+                        "contact_nodes": ts["contact_nodes"]})
+    for col in ("kinetic_colon_J", "internal_colon_J", "kinetic_scope_J", "internal_scope_J", "contact_energy_J",
+                "dt_s", "step"):
+        out[col] = ts[col]
+    return out
+
+
+def insertion_figure(results) -> Figure:
+    """Deformation, forces, energy ratio and tip displacement of one or several runs."""
+    fig = Figure(figsize=(11, 7.5))
+    axes = fig.subplots(2, 2)
+    for r in results:
+        ts = r.timeseries
+        label = f"{r.summary['scope']['name']} ({r.case.segment.upper()}, D {r.case.diameter_mm:g} mm, mu {r.case.friction:g})"
+        axes[0, 0].plot(ts["time_s"], ts["deformation_m"] * 100, label=label)
+        axes[0, 1].plot(ts["time_s"], ts["contact_force_N"], label=f"{label}: contact")
+        axes[0, 1].plot(ts["time_s"], ts["push_force_N"], "--", lw=0.8, label=f"{label}: push")
+        with np.errstate(divide="ignore", invalid="ignore"):
+            for body, style in (("colon", "-"), ("scope", ":")):
+                ratio = ts[f"kinetic_{body}_J"] / ts[f"internal_{body}_J"]
+                axes[1, 0].plot(ts["time_s"], ratio, style, label=f"{label}: {body}")
+        axes[1, 1].plot(ts["time_s"], ts["tip_displacement_m"] * 100, label=label)
+        for name, p in r.summary["points_cm"].items():
+            if p is not None:
+                axes[0, 0].annotate(name, (p["time_s"], p["deformation_cm"]), textcoords="offset points", xytext=(0, 6),
+                                    ha="center", fontsize=9)
+    axes[0, 0].set_ylabel("colon deformation [cm]")
+    axes[0, 1].set_ylabel("force [N]")
+    axes[1, 0].set_ylabel("kinetic / internal energy")
+    axes[1, 0].axhline(0.1, c="0.5", lw=0.8)
+    axes[1, 0].set_yscale("log")
+    axes[1, 1].set_ylabel("tip displacement [cm]")
+    for ax in axes.ravel():
+        ax.set_xlabel("time [s]")
+        ax.legend(fontsize=7)
+    return fig
+
+
+def _write_vtu(path, points, cells, cell_type):
+    import meshio
+
+    with atomic_path(path) as tmp:
+        meshio.Mesh(points, [(cell_type, cells)]).write(tmp, file_format="vtu")
+
+
+def write_vtu_series(result, folder):
+    """Deformed colon (triangles) and scope (lines) of every snapshot, with ParaView .pvd indexes."""
+    try:
+        import meshio  # noqa: F401
+    except ImportError:
+        from colonsim.errors import ColonsimError
+
+        raise ColonsimError("VTU output needs meshio: pip install 'colonsim[io]' (or pip install meshio)") from None
+    folder = Path(folder)
+    entries = {"colon": [], "scope": []}
+    for k, (t, xc, xs) in enumerate(result.snapshots):
+        for name, x, cells, kind in (("colon", xc, result.model.shell.triangles, "triangle"),
+                                     ("scope", xs, result.model.rod.segments, "line")):
+            file = f"{name}_{k:04d}.vtu"
+            _write_vtu(folder / file, x, cells, kind)
+            entries[name].append((t, file))
+    for name, items in entries.items():
+        lines = ['<?xml version="1.0"?>', '<VTKFile type="Collection" version="0.1">', "<Collection>"]
+        lines += [f'<DataSet timestep="{t:.6g}" file="{f}"/>' for t, f in items]
+        lines += ["</Collection>", "</VTKFile>"]
+        with atomic_path(folder / f"{name}.pvd") as tmp:
+            tmp.write_text("\n".join(lines) + "\n")
+
+
+def write_insertion(result, out_dir, vtu=False) -> dict:
+    """Write the files of one run into ``out_dir``; return their paths."""
+    out = Path(out_dir)
+    paths = {"timeseries": out / "timeseries.csv", "summary": out / "summary.json", "plot": out / "insertion.png"}
+    write_csv(paths["timeseries"], user_units(result.timeseries))
+    write_json(paths["summary"], result.summary)
+    save_figure(insertion_figure([result]), paths["plot"])
+    if vtu:
+        write_vtu_series(result, out / "vtu")
+        paths["vtu"] = out / "vtu"
+    return paths

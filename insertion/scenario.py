@@ -1,0 +1,282 @@
+"""A colonoscopy insertion (SPEC.md 2): colon segment + scope + manoeuvre -> explicit simulation.
+
+:class:`InsertionCase` holds every input with the SPEC value as default (mm, degrees and cm/s
+are the user's units; SI inside). :func:`build_insertion` turns it into bodies, contact,
+constraints and a push profile; :func:`run_insertion` integrates and records the outputs of
+SPEC.md 2.4 through :class:`insertion.recording.InsertionRecorder`.
+
+Modelling choices (stated so they can be cited):
+- the scope starts straight inside a rigid sheath on the extension of the colon entry axis, its
+  tip at the entry plane; the sheath guides every scope node still behind the entry plane;
+- the proximal scope node is driven along the sheath axis by the push profile; the push force is
+  that constraint's reaction;
+- fixed colon parts and the end rings are held (zero velocity); the mobile part is free;
+- quasi-static runs use mass-proportional damping, by default 60 1/s on the colon (about
+  critical for its lowest bending modes of ~10 Hz) and 5 1/s on the scope (its rigid push
+  through the sheath would otherwise feel a drag of alpha m v);
+- no gravity, no insufflation pressure (SPEC.md does not model them);
+- the run ends when the pushed depth reaches the colon's centerline length minus half a
+  diameter (the tip then lies at the far end ring: "the tip has passed the fixed end").
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import math
+from dataclasses import asdict, dataclass
+
+import numpy as np
+
+from colonsim.errors import ColonsimError
+from insertion.contact import RodShellContact
+from insertion.manoeuvre import continuous_push, straighten_relax_push
+from insertion.material import REFERENCE_MATERIAL_PATH, load_material
+from insertion.scopes import colonoscope
+from insertion.shell import Shell
+from insertion.solver import ExplicitSolver, FixedNodes, LineConstraint, PrescribedVelocity
+
+SEGMENTS = ("rsj", "rsf", "thf", "thf-fixed", "straight")
+# SPEC.md 2.1; "straight" is the sanity case (a 20 cm straight tube), not one of the source's models.
+SCOPE_LENGTH_M = {"rsj": 0.30, "rsf": 0.70, "thf": 0.50, "thf-fixed": 0.50, "straight": 0.30}
+COLON_DENSITY = 1040.0  # kg/m^3
+
+
+@dataclass
+class InsertionCase:
+    """Every input of one insertion (user units: mm, degrees, m/s, 1/s).
+
+    Attributes
+    ----------
+    segment : {"rsj", "rsf", "thf", "thf-fixed"}
+    scope : str
+        ``utc``, ``pdc``, ``sdc`` or an outer diameter in mm.
+    diameter_mm : float
+        Colon inner diameter (SPEC.md: 23 or 36 for RSJ; 36 assumed elsewhere).
+    angle_deg : float
+        alpha of RSF or beta of THF (ignored for RSJ).
+    friction : float
+        Coulomb coefficient mu between scope and wall.
+    wall_thickness_mm : float
+        Colon wall thickness (**assumption** 2 mm).
+    material : str or None
+        Material JSON (``colonsim calibrate`` output); None = the source's parameters.
+    element_size_mm, scope_spacing_mm : float
+        Wall triangle size and scope node spacing.
+    push_speed : float
+        Plateau push speed, m/s (SPEC.md: 0.6).
+    ramp_s, relax_s : float
+        Speed-change ramp and the relax pause of RSF/THF, s.
+    colon_damping, scope_damping : float
+        Mass-proportional damping, 1/s.
+    record_interval_s : float
+        Simulated time between recorded samples.
+    time_step_factor : float
+        Safety factor on the stable time step.
+    """
+
+    segment: str = "rsj"
+    scope: str = "sdc"
+    diameter_mm: float = 36.0
+    angle_deg: float = 0.0
+    friction: float = 0.0
+    wall_thickness_mm: float = 2.0
+    material: str | None = None
+    element_size_mm: float = 3.0
+    scope_spacing_mm: float = 5.0
+    push_speed: float = 0.6
+    ramp_s: float = 0.05
+    relax_s: float = 0.1
+    colon_damping: float = 60.0
+    scope_damping: float = 5.0
+    record_interval_s: float = 1e-3
+    time_step_factor: float = 0.9
+
+    def validate(self):
+        """Raise :class:`ColonsimError` naming the first bad input and its fix."""
+        if self.segment not in SEGMENTS:
+            raise ColonsimError(f"unknown colon segment {self.segment!r}; use one of {', '.join(SEGMENTS)}")
+        checks = [
+            ("diameter_mm", self.diameter_mm, 10.0, 80.0, "colon inner diameter in mm (23 or 36 in the source)"),
+            ("wall_thickness_mm", self.wall_thickness_mm, 0.2, 10.0, "wall thickness in mm (2 assumed)"),
+            ("element_size_mm", self.element_size_mm, 0.5, 20.0, "wall element size in mm (3 by default)"),
+            ("scope_spacing_mm", self.scope_spacing_mm, 1.0, 50.0, "scope node spacing in mm (5 by default)"),
+            ("push_speed", self.push_speed, 1e-3, 5.0, "push speed in m/s (0.6 in the source)"),
+            ("colon_damping", self.colon_damping, 0.0, 1e4, "damping in 1/s"),
+            ("scope_damping", self.scope_damping, 0.0, 1e4, "damping in 1/s"),
+            ("record_interval_s", self.record_interval_s, 1e-6, 1.0, "recording interval in s"),
+            ("time_step_factor", self.time_step_factor, 0.01, 1.0, "a safety factor in (0, 1]"),
+            ("ramp_s", self.ramp_s, 0.0, 10.0, "ramp duration in s"),
+            ("relax_s", self.relax_s, 0.0, 10.0, "relax duration in s"),
+        ]
+        for name, value, lo, hi, what in checks:
+            if not (isinstance(value, (int, float)) and math.isfinite(value) and lo <= value <= hi):
+                raise ColonsimError(f"{name} = {value!r} is outside [{lo:g}, {hi:g}]; give the {what}")
+        if not (math.isfinite(self.friction) and 0.0 <= self.friction <= 2.0):
+            raise ColonsimError(f"friction = {self.friction!r} must lie in [0, 2] (the source used 0, 0.05, 0.1)")
+        if self.element_size_mm > self.diameter_mm / 3:
+            raise ColonsimError(f"element size {self.element_size_mm} mm is too coarse for a {self.diameter_mm} mm colon; "
+                                "use at most a third of the diameter")
+        colonoscope(self.scope).check_fits(self.diameter_mm * 1e-3)
+
+    def to_dict(self) -> dict:
+        return asdict(self)
+
+    def key(self) -> str:
+        """A short hash of the inputs (identifies a run in sweeps and output folders)."""
+        return hashlib.sha256(json.dumps(self.to_dict(), sort_keys=True).encode()).hexdigest()[:12]
+
+
+@dataclass
+class Insertion:
+    """A built insertion model, ready to run."""
+
+    case: InsertionCase
+    geometry: object
+    shell: Shell
+    rod: object
+    scope: object
+    contact: RodShellContact
+    push: PushProfile | None
+    solver: ExplicitSolver
+    drive: PrescribedVelocity
+    entry_point: np.ndarray
+    entry_axis: np.ndarray
+    mobile_nodes: np.ndarray
+    fixed_nodes: np.ndarray
+    total_depth: float
+
+
+from insertion.manoeuvre import PushProfile  # noqa: E402  (type used above)
+
+
+def build_insertion(case: InsertionCase) -> Insertion:
+    """Bodies, contact, constraints and manoeuvre of ``case`` (SI inside)."""
+    from insertion.colon_segments import colon_geometry
+
+    case.validate()
+    D = case.diameter_mm * 1e-3
+    geometry = colon_geometry(case.segment, D, case.angle_deg, case.element_size_mm * 1e-3,
+                              case.wall_thickness_mm * 1e-3)
+    material = load_material(case.material or REFERENCE_MATERIAL_PATH)
+    shell = Shell(geometry.nodes, geometry.triangles, case.wall_thickness_mm * 1e-3, material,
+                  density=COLON_DENSITY, name="colon")
+
+    scope = colonoscope(case.scope)
+    entry = np.asarray(geometry.entry_point, dtype=float)
+    axis = np.asarray(geometry.entry_axis, dtype=float)
+    axis = axis / np.linalg.norm(axis)
+    length = SCOPE_LENGTH_M[case.segment]
+    rod = scope.rod(start=entry - length * axis, direction=axis, length=length,
+                    spacing=case.scope_spacing_mm * 1e-3)
+
+    total_depth = geometry.centerline_length - 0.5 * D
+    if total_depth > length:
+        raise ColonsimError(f"the {length * 100:.0f} cm scope is shorter than the {total_depth * 100:.1f} cm to push; "
+                            "this segment's geometry is too long for its scope length")
+    if geometry.straighten_depth is None:
+        push = continuous_push(total_depth, case.push_speed, case.ramp_s)
+    else:
+        push = straighten_relax_push(geometry.straighten_depth, total_depth, case.push_speed, case.ramp_s,
+                                     max(case.relax_s, case.ramp_s))
+
+    contact = RodShellContact(rod, shell, friction=case.friction)
+    held = np.flatnonzero(geometry.fixed | geometry.end_ring)
+    constraints = [FixedNodes(shell, held)]
+    mobile = np.flatnonzero(geometry.mobile & ~geometry.end_ring)
+    if geometry.straighten_depth is not None:
+        straighten = push.phases[0]
+        # Lateral motion of the mobile part blocked while straightening ("birth and death"):
+        # each mobile node may only move along the axis of the straight piece it belongs to.
+        for direction, nodes in geometry.mobile_axes:
+            constraints.append(LineConstraint(shell, point=geometry.nodes[nodes[0]], direction=direction,
+                                              nodes=nodes, start=straighten.start, end=straighten.end))
+    drive = PrescribedVelocity(rod, [0], lambda t: push.speed(t) * axis)
+    # The sheath: every scope node behind the entry plane moves only along the entry axis.
+    sheath = LineConstraint(rod, point=entry, direction=axis, extent=(-math.inf, -0.5 * scope.diameter))
+    constraints += [drive, sheath]
+    solver = ExplicitSolver([rod, shell], contacts=[contact], constraints=constraints,
+                            damping={rod.name: case.scope_damping, "colon": case.colon_damping},
+                            time_step_factor=case.time_step_factor)
+    return Insertion(case, geometry, shell, rod, scope, contact, push, solver, drive, entry, axis, mobile, held,
+                     total_depth)
+
+
+@dataclass
+class InsertionResult:
+    """Recorded time series (SI columns), the summary of SPEC.md 2.4 and optional snapshots."""
+
+    case: InsertionCase
+    timeseries: object  # pandas.DataFrame
+    summary: dict
+    snapshots: list
+    model: Insertion
+
+
+def run_insertion(case: InsertionCase, progress=None, snapshot_interval=None, chunk_s=0.01) -> InsertionResult:
+    """Build and run one insertion.
+
+    Parameters
+    ----------
+    case : InsertionCase
+    progress : callable(depth_m, total_depth_m) or None
+        Called after every ``chunk_s`` of simulated time.
+    snapshot_interval : float or None
+        Simulated time between stored wall/scope positions (for VTU output), s.
+    """
+    import time as _time
+
+    from insertion.recording import InsertionRecorder
+
+    t_build = _time.perf_counter()
+    model = build_insertion(case)
+    recorder = InsertionRecorder(model, snapshot_interval)
+    t0 = _time.perf_counter()
+    duration = model.push.duration
+    while model.solver.time < duration - 1e-9:
+        step = min(chunk_s, duration - model.solver.time)
+        model.solver.run(step, record_interval=case.record_interval_s, callbacks=[recorder])
+        if progress is not None:
+            progress(model.push.depth(model.solver.time), model.total_depth)
+    if not recorder.rows or recorder.rows[-1]["time_s"] < model.solver.time:
+        recorder(model.solver)  # the final state is always a sample
+    wall = _time.perf_counter() - t0
+    frame = recorder.frame()
+    summary = summarize(model, frame, wall, t0 - t_build)
+    return InsertionResult(case, frame, summary, recorder.snapshots, model)
+
+
+def summarize(model: Insertion, ts, wall_s, build_s) -> dict:
+    """The summary of one run: deformation, points A/B/C, forces, energy check, sizes, inputs."""
+    from insertion.outcomes import characteristic_points, quasi_static_fraction
+
+    points = characteristic_points(ts["time_s"], ts["depth_m"], ts["deformation_m"])
+    qs = {body: quasi_static_fraction(ts[f"kinetic_{body}_J"], ts[f"internal_{body}_J"]) for body in ("colon", "scope")}
+    g = model.geometry
+    return {
+        "inputs": model.case.to_dict(),
+        "key": model.case.key(),
+        "scope": model.scope.describe(),
+        "final_deformation_cm": float(ts["deformation_m"].iloc[-1] * 100),
+        "max_deformation_cm": float(ts["deformation_m"].max() * 100),
+        "points_cm": {k: (None if v is None else {"deformation_cm": v["deformation_m"] * 100,
+                                                    "depth_cm": v["depth_m"] * 100, "time_s": v["time_s"]})
+                      for k, v in points.items()},
+        "peak_contact_force_N": float(ts["contact_force_N"].max()),
+        "peak_push_force_N": float(ts["push_force_N"].max()),
+        "max_wall_stretch": float(ts["max_stretch"].max()),
+        "final_tip_arc_cm": float(ts["tip_arc_m"].iloc[-1] * 100),
+        "quasi_static": {
+            "criterion": "kinetic / internal energy < 10 % on most (> 50 %) of the samples, per body",
+            "fraction_below_10pct": qs,
+            "holds": bool(all(f > 0.5 for f in qs.values())),
+        },
+        "simulated_time_s": float(ts["time_s"].iloc[-1]),
+        "steps": int(model.solver.step),
+        "time_step_s": {"min": float(ts["dt_s"].min()), "max": float(ts["dt_s"].max())},
+        "wall_time_s": float(wall_s),
+        "build_time_s": float(build_s),
+        "mesh": {**g.summary(), "scope_nodes": int(model.rod.n_nodes), "hinges": int(len(model.shell.hinges))},
+        "material": {"C10": model.shell.material.C10, "C01": model.shell.material.C01, "C11": model.shell.material.C11,
+                     "file": model.case.material or str(REFERENCE_MATERIAL_PATH)},
+    }
