@@ -145,6 +145,7 @@ class Insertion:
     mobile_nodes: np.ndarray
     fixed_nodes: np.ndarray
     total_depth: float
+    tip_end: float
 
 
 from insertion.manoeuvre import PushProfile  # noqa: E402  (type used above)
@@ -166,14 +167,16 @@ def build_insertion(case: InsertionCase) -> Insertion:
     entry = np.asarray(geometry.entry_point, dtype=float)
     axis = np.asarray(geometry.entry_axis, dtype=float)
     axis = axis / np.linalg.norm(axis)
-    length = SCOPE_LENGTH_M[case.segment]
+    # The run ends when the tip has passed the fixed end (tip arc position >= end_depth). The
+    # scope lags behind the pushed depth when it bows, so the push may go up to 1.6 x further
+    # (a cap that also stops a scope that loops without progress); the scope starts wholly in
+    # the sheath, so it must be longer than that: the source's lengths (SPEC.md 2.1) are kept
+    # where they suffice, else lengthened (the summary reports the length used).
+    tip_end = geometry.end_depth
+    length = max(SCOPE_LENGTH_M[case.segment], tip_end + 0.05)
+    total_depth = max(min(1.6 * tip_end, length - 0.02), tip_end)
     rod = scope.rod(start=entry - length * axis, direction=axis, length=length,
                     spacing=case.scope_spacing_mm * 1e-3)
-
-    total_depth = geometry.centerline_length - 0.5 * D
-    if total_depth > length:
-        raise ColonsimError(f"the {length * 100:.0f} cm scope is shorter than the {total_depth * 100:.1f} cm to push; "
-                            "this segment's geometry is too long for its scope length")
     if geometry.straighten_depth is None:
         push = continuous_push(total_depth, case.push_speed, case.ramp_s)
     else:
@@ -199,7 +202,7 @@ def build_insertion(case: InsertionCase) -> Insertion:
                             damping={rod.name: case.scope_damping, "colon": case.colon_damping},
                             time_step_factor=case.time_step_factor)
     return Insertion(case, geometry, shell, rod, scope, contact, push, solver, drive, entry, axis, mobile, held,
-                     total_depth)
+                     total_depth, tip_end)
 
 
 @dataclass
@@ -219,8 +222,9 @@ def run_insertion(case: InsertionCase, progress=None, snapshot_interval=None, ch
     Parameters
     ----------
     case : InsertionCase
-    progress : callable(depth_m, total_depth_m) or None
-        Called after every ``chunk_s`` of simulated time.
+    progress : callable(tip_arc_m, tip_end_m) or None
+        Called after every ``chunk_s`` of simulated time with the tip's position along the
+        centerline and the position at which the run ends.
     snapshot_interval : float or None
         Simulated time between stored wall/scope positions (for VTU output), s.
     """
@@ -233,16 +237,23 @@ def run_insertion(case: InsertionCase, progress=None, snapshot_interval=None, ch
     recorder = InsertionRecorder(model, snapshot_interval)
     t0 = _time.perf_counter()
     duration = model.push.duration
+    last_phase = model.push.phases[-1]
+    ended_by = f"push depth cap {model.total_depth * 100:.1f} cm reached before the tip passed the fixed end"
     while model.solver.time < duration - 1e-9:
         step = min(chunk_s, duration - model.solver.time)
         model.solver.run(step, record_interval=case.record_interval_s, callbacks=[recorder])
+        if not recorder.rows or recorder.rows[-1]["time_s"] < model.solver.time:
+            recorder(model.solver)  # the state at the end of every chunk is a sample
+        tip_arc = recorder.rows[-1]["tip_arc_m"]
         if progress is not None:
-            progress(model.push.depth(model.solver.time), model.total_depth)
-    if not recorder.rows or recorder.rows[-1]["time_s"] < model.solver.time:
-        recorder(model.solver)  # the final state is always a sample
+            progress(tip_arc, model.tip_end)
+        if model.solver.time >= last_phase.start and tip_arc >= model.tip_end:
+            ended_by = "the tip passed the fixed end"
+            break
     wall = _time.perf_counter() - t0
     frame = recorder.frame()
     summary = summarize(model, frame, wall, t0 - t_build)
+    summary["ended_by"] = ended_by
     return InsertionResult(case, frame, summary, recorder.snapshots, model)
 
 
@@ -256,7 +267,9 @@ def summarize(model: Insertion, ts, wall_s, build_s) -> dict:
     return {
         "inputs": model.case.to_dict(),
         "key": model.case.key(),
-        "scope": model.scope.describe(),
+        "scope": {**model.scope.describe(), "length_cm": float(model.rod.rest_length.sum() * 100)},
+        "pushed_depth_cm": float(ts["depth_m"].iloc[-1] * 100),
+        "tip_end_cm": float(model.tip_end * 100),
         "final_deformation_cm": float(ts["deformation_m"].iloc[-1] * 100),
         "max_deformation_cm": float(ts["deformation_m"].max() * 100),
         "points_cm": {k: (None if v is None else {"deformation_cm": v["deformation_m"] * 100,

@@ -116,6 +116,15 @@ def straight_tube(length, diameter, h):
     phi = 2.0 * np.pi * (j + 0.5 * (k % 2)) / m
     nodes = np.column_stack((xs[k], radius * np.cos(phi), radius * np.sin(phi)))
 
+    centres = np.column_stack((xs[k], np.zeros(len(k)), np.zeros(len(k))))
+    triangles = orient_outward(nodes, ring_triangles(n_rings, m), centres)
+    return nodes, triangles, k.astype(np.int64)
+
+
+def ring_triangles(n_rings, m):
+    """Triangles between ``n_rings`` rings of ``m`` nodes (node ``k m + j``: ring k, position j),
+    odd rings rotated by half a step, so every strip is a zig-zag of near-equilateral triangles.
+    Orientation is not yet consistent: pass the result through :func:`orient_outward`."""
     jj = np.arange(m)
     jn = (jj + 1) % m
     tris = []
@@ -127,16 +136,19 @@ def straight_tube(length, diameter, h):
         else:  # lower node jj sits between upper jj and jj + 1
             tris.append(np.column_stack((lo + jj, up + jn, up + jj)))
             tris.append(np.column_stack((lo + jj, lo + jn, up + jn)))
-    triangles = np.vstack(tris).astype(np.int64)
-    # Orient outward: normal . (centroid - axis) > 0.
+    return np.vstack(tris).astype(np.int64)
+
+
+def orient_outward(nodes, triangles, centres):
+    """Flip triangles so their normals point away from the ring centres of their nodes
+    (``centres`` (n, 3): the centerline point of each node's ring)."""
+    triangles = triangles.copy()
     p = nodes[triangles]
     normal = np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0])
-    centroid = p.mean(axis=1)
-    radial = centroid.copy()
-    radial[:, 0] = 0.0
+    radial = p.mean(axis=1) - centres[triangles].mean(axis=1)
     flip = np.einsum("ij,ij->i", normal, radial) < 0.0
     triangles[flip] = triangles[flip][:, [0, 2, 1]]
-    return nodes, triangles, k.astype(np.int64)
+    return triangles
 
 
 def hinges(triangles):
