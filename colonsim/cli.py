@@ -195,9 +195,18 @@ def cmd_demo(args):
                              analytic=False, mesh=(8, 3), points=20, quick=True, seed=1, workers=1,
                              no_progress=args.no_progress)
     run_calibration(cal, out / "calibration")
+
+    from insertion.scenario import InsertionCase
+
+    print("\ncolonsim demo: RSJ insertions (D = 36 mm, mu = 0) of the three scopes with the material just "
+          "calibrated. PRELIMINARY: the insertion model is still being validated against the source "
+          "(benchmarks/bench_insertion.py prints the comparison).", flush=True)
+    material = str(out / "calibration" / "material.json")
+    cases = [InsertionCase(segment="rsj", scope=s, diameter_mm=36.0, material=material) for s in ("utc", "pdc", "sdc")]
+    run_insertions(cases, out / "insertion", show=not args.no_progress)
     print(f"\ndemo finished in {time.perf_counter() - t0:.0f} s; outputs in {out}/")
-    print("Not there yet: the insertion solver (issue 3), colonoscopy scenarios (4), sweeps and the surrogate (5). "
-          "The demo will run them as they land.")
+    print("Not there yet: insertion sweeps and the surrogate pain predictor (issue 5), notebooks and the "
+          "validation report (issue 6).")
 
 
 def _add_insert(sub):

@@ -40,14 +40,15 @@ def insertion_figure(results) -> Figure:
     for r in results:
         ts = r.timeseries
         label = f"{r.summary['scope']['name']} ({r.case.segment.upper()}, D {r.case.diameter_mm:g} mm, mu {r.case.friction:g})"
-        axes[0, 0].plot(ts["time_s"], ts["deformation_m"] * 100, label=label)
-        axes[0, 1].plot(ts["time_s"], ts["contact_force_N"], label=f"{label}: contact")
-        axes[0, 1].plot(ts["time_s"], ts["push_force_N"], "--", lw=0.8, label=f"{label}: push")
-        with np.errstate(divide="ignore", invalid="ignore"):
-            for body, style in (("colon", "-"), ("scope", ":")):
-                ratio = ts[f"kinetic_{body}_J"] / ts[f"internal_{body}_J"]
-                axes[1, 0].plot(ts["time_s"], ratio, style, label=f"{label}: {body}")
-        axes[1, 1].plot(ts["time_s"], ts["tip_displacement_m"] * 100, label=label)
+        line, = axes[0, 0].plot(ts["time_s"], ts["deformation_m"] * 100, label=label)
+        colour = line.get_color()
+        axes[0, 1].plot(ts["time_s"], ts["contact_force_N"], c=colour, label=f"{label}: contact")
+        axes[0, 1].plot(ts["time_s"], ts["push_force_N"], "--", c=colour, lw=0.6, alpha=0.6, label=f"{label}: push")
+        for body, style in (("colon", "-"), ("scope", ":")):
+            # the ratio is meaningless before the body stores strain energy (round-off level)
+            internal = ts[f"internal_{body}_J"].where(ts[f"internal_{body}_J"] > 1e-9)
+            axes[1, 0].plot(ts["time_s"], ts[f"kinetic_{body}_J"] / internal, style, c=colour, label=f"{label}: {body}")
+        axes[1, 1].plot(ts["time_s"], ts["tip_displacement_m"] * 100, c=colour, label=label)
         for name, p in r.summary["points_cm"].items():
             if p is not None:
                 axes[0, 0].annotate(name, (p["time_s"], p["deformation_cm"]), textcoords="offset points", xytext=(0, 6),
