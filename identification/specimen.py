@@ -22,7 +22,7 @@ from scipy.sparse.linalg import splu
 from skfem import Basis, ElementTriP1, ElementTriP2, MeshTri
 
 from colonsim.errors import ColonsimError
-from identification.laws import Law, get_law
+from identification.laws import get_law
 from identification.membrane import membrane_stress
 
 
