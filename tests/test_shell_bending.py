@@ -5,7 +5,6 @@ energy per unit area of the sheet's interior must be the plate value D / (2 R^2)
 D = E0 t^3 / 9 (nu = 1/2), whatever the cylinder's direction relative to the mesh.
 """
 
-import numba
 import numpy as np
 import pytest
 
@@ -16,16 +15,6 @@ from insertion.shell import Shell, dihedral_angles
 MATERIAL = load_material(REFERENCE_MATERIAL_PATH)
 THICKNESS = 0.002
 SIDE, H = 0.06, 0.003  # 516 nodes; the interior (2 h from the edges) holds ~900 hinges
-
-
-@pytest.fixture
-def serial_kernels():
-    """Run the kernels on one thread: these checks call them hundreds of times on tiny meshes,
-    where waking a second thread on a loaded machine costs more than the work itself."""
-    previous = numba.get_num_threads()
-    numba.set_num_threads(1)
-    yield
-    numba.set_num_threads(previous)
 
 
 def _bending(shell, x):

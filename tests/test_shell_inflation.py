@@ -19,7 +19,6 @@ the discrete relation is p(l) / cos(pi / m) (+0.34 % for m = 38).
 
 import os
 
-import numba
 import numpy as np
 import pytest
 
@@ -31,16 +30,6 @@ from insertion.statics import minimize_energy
 MATERIAL = load_material(REFERENCE_MATERIAL_PATH)
 RADIUS, THICKNESS, H = 0.018, 0.002, 0.003
 FULL = os.environ.get("COLONSIM_FULL") == "1"
-
-
-@pytest.fixture
-def serial_kernels():
-    """Run the kernels on one thread: these checks call them hundreds of times on tiny meshes,
-    where waking a second thread on a loaded machine costs more than the work itself."""
-    previous = numba.get_num_threads()
-    numba.set_num_threads(1)
-    yield
-    numba.set_num_threads(previous)
 
 
 def thin_wall_pressure(stretch):

@@ -1,7 +1,6 @@
 """Membrane of the shell: forces are the energy gradient, and homogeneous uniaxial tension of a
 flat triangulated sheet reproduces the closed-form incompressible Mooney-Rivlin nominal stress."""
 
-import numba
 import numpy as np
 import pytest
 
@@ -20,16 +19,6 @@ MATERIALS = {
     "mooney_rivlin_2": MooneyRivlin(15e3, 5e3, 0.0),
 }
 LENGTH, WIDTH, THICKNESS, H = 0.10, 0.025, 0.002, 0.005
-
-
-@pytest.fixture
-def serial_kernels():
-    """Run the kernels on one thread: these checks call them hundreds of times on tiny meshes,
-    where waking a second thread on a loaded machine costs more than the work itself."""
-    previous = numba.get_num_threads()
-    numba.set_num_threads(1)
-    yield
-    numba.set_num_threads(previous)
 
 
 def _sheet(material):

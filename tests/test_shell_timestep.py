@@ -1,7 +1,6 @@
 """Stable explicit time step of the shell against the dilatational wave estimate and against the
 exact largest eigenfrequency of the assembled, lumped-mass system."""
 
-import numba
 import numpy as np
 import pytest
 
@@ -11,16 +10,6 @@ from insertion.shell import Shell
 
 MATERIAL = load_material(REFERENCE_MATERIAL_PATH)
 DENSITY = 1040.0
-
-
-@pytest.fixture
-def serial_kernels():
-    """Run the kernels on one thread: these checks call them hundreds of times on tiny meshes,
-    where waking a second thread on a loaded machine costs more than the work itself."""
-    previous = numba.get_num_threads()
-    numba.set_num_threads(1)
-    yield
-    numba.set_num_threads(previous)
 
 
 def _exact_time_step(shell, x):
