@@ -234,10 +234,9 @@ def run_insertions(cases, out: Path, vtu=False, snapshot_every=0.02, show=True):
     """Run each case, write its folder under ``out`` and a comparison; return the results."""
     from tqdm import tqdm
 
-    from insertion.results import insertion_figure, write_insertion
-    from insertion.scenario import run_insertion
     from colonsim.files import save_figure, write_csv
-    import pandas as pd
+    from insertion.results import comparison_table, insertion_figure, write_insertion
+    from insertion.scenario import run_insertion
 
     for case in cases:
         case.validate()  # all inputs checked before the first (long) run starts
@@ -266,17 +265,7 @@ def run_insertions(cases, out: Path, vtu=False, snapshot_every=0.02, show=True):
               f"(KE/IE < 10 %: colon {100 * s['quasi_static']['fraction_below_10pct']['colon']:.0f} %, "
               f"scope {100 * s['quasi_static']['fraction_below_10pct']['scope']:.0f} % of samples); "
               f"{s['steps']} steps in {s['wall_time_s']:.1f} s -> {folder}/")
-    table = pd.DataFrame([{"segment": r.case.segment, "scope": r.summary["scope"]["name"],
-                           "scope_diameter_mm": r.summary["scope"]["diameter_mm"], "colon_diameter_mm": r.case.diameter_mm,
-                           "angle_deg": r.case.angle_deg, "friction": r.case.friction,
-                           "final_deformation_cm": r.summary["final_deformation_cm"],
-                           "max_deformation_cm": r.summary["max_deformation_cm"],
-                           **{f"point_{k}_cm": (None if v is None else v["deformation_cm"]) for k, v in r.summary["points_cm"].items()},
-                           "peak_contact_force_N": r.summary["peak_contact_force_N"],
-                           "peak_push_force_N": r.summary["peak_push_force_N"],
-                           "max_wall_stretch": r.summary["max_wall_stretch"],
-                           "quasi_static": r.summary["quasi_static"]["holds"], "wall_time_s": r.summary["wall_time_s"]}
-                          for r in results])
+    table = comparison_table(results)
     write_csv(out / "comparison.csv", table)
     save_figure(insertion_figure(results), out / "comparison.png")
     print(f"comparison: {out}/comparison.csv, {out}/comparison.png")

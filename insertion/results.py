@@ -32,6 +32,21 @@ def user_units(ts: pd.DataFrame) -> pd.DataFrame:
     return out
 
 
+def comparison_table(results) -> pd.DataFrame:
+    """One row of scalar outcomes per run (cm, N), for comparing scopes or cases."""
+    return pd.DataFrame([{"segment": r.case.segment, "scope": r.summary["scope"]["name"],
+                           "scope_diameter_mm": r.summary["scope"]["diameter_mm"], "colon_diameter_mm": r.case.diameter_mm,
+                           "angle_deg": r.case.angle_deg, "friction": r.case.friction,
+                           "final_deformation_cm": r.summary["final_deformation_cm"],
+                           "max_deformation_cm": r.summary["max_deformation_cm"],
+                           **{f"point_{k}_cm": (None if v is None else v["deformation_cm"]) for k, v in r.summary["points_cm"].items()},
+                           "peak_contact_force_N": r.summary["peak_contact_force_N"],
+                           "peak_push_force_N": r.summary["peak_push_force_N"],
+                           "max_wall_stretch": r.summary["max_wall_stretch"],
+                           "quasi_static": r.summary["quasi_static"]["holds"], "wall_time_s": r.summary["wall_time_s"]}
+                          for r in results])
+
+
 def insertion_figure(results) -> Figure:
     """Deformation, forces, energy ratio and tip displacement of one or several runs."""
     fig = Figure(figsize=(11, 7.5))
