@@ -225,6 +225,9 @@ def _add_insert(sub):
     p.add_argument("--material", help="material JSON from colonsim calibrate (default: the source's parameters)")
     p.add_argument("--vtu", action="store_true", help="write deformed meshes for ParaView (needs meshio)")
     p.add_argument("--snapshot-every", type=float, default=0.02, help="simulated seconds between VTU snapshots")
+    p.add_argument("--threads", type=int, default=None,
+                   help="Numba threads (default: all cores). Use 1 when running several insertions side by side: "
+                        "oversubscribed threads slow the kernels down by an order of magnitude")
     p.add_argument("--out", type=Path, default=Path("colonsim_results/insertion"), help="output folder")
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
     p.set_defaults(func=cmd_insert)
@@ -273,7 +276,14 @@ def run_insertions(cases, out: Path, vtu=False, snapshot_every=0.02, show=True):
 
 
 def cmd_insert(args):
+    import numba
+
     from insertion.scenario import InsertionCase
+
+    if args.threads is not None:
+        if not 1 <= args.threads <= numba.config.NUMBA_NUM_THREADS:
+            raise ColonsimError(f"--threads {args.threads} must lie in 1-{numba.config.NUMBA_NUM_THREADS} (the cores Numba sees)")
+        numba.set_num_threads(args.threads)
 
     cases = [InsertionCase(segment=args.segment, scope=scope, diameter_mm=args.diameter, angle_deg=args.angle,
                            friction=args.friction, wall_thickness_mm=args.wall_thickness,
