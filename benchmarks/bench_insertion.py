@@ -28,13 +28,14 @@ def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--quick", action="store_true")
     parser.add_argument("--threads", type=int, default=None)
+    parser.add_argument("--exit-length", type=float, default=0.0, help="RSJ fixed exit piece, mm (0: SPEC.md's model)")
     args = parser.parse_args()
     if args.threads:
         numba.set_num_threads(args.threads)
     print(f"numba threads: {numba.get_num_threads()}")
     run_insertion(InsertionCase(segment="straight", scope="sdc", element_size_mm=6.0))  # compile / cache warm-up
     t0 = time.perf_counter()
-    r = run_insertion(InsertionCase(segment="rsj", scope="sdc", diameter_mm=36.0))
+    r = run_insertion(InsertionCase(segment="rsj", scope="sdc", diameter_mm=36.0, exit_length_mm=args.exit_length))
     wall = time.perf_counter() - t0
     s = r.summary
     print(f"RSJ D36 SDC end to end: {wall:.1f} s wall (build {s['build_time_s']:.1f} s, {s['steps']} steps, "
@@ -42,10 +43,11 @@ def main():
           f"{s['mesh']['wall_triangles']} triangles)   (target < 60 s; source 100 min)")
     if args.quick:
         return
-    print("\nRSJ colon deformation [cm], mu = 0: this project vs the source (LS-DYNA)")
+    print(f"\nRSJ colon deformation [cm], mu = 0, exit length {args.exit_length:g} mm: this project vs the source (LS-DYNA)")
     print(f"{'case':>9} | {'A ours':>6} {'A src':>6} | {'C ours':>6} {'C src':>6} | {'final':>6} {'max':>6} | C>A  quasi-static(colon/scope)")
     for (scope, d), (a_ref, c_ref) in REFERENCE.items():
-        s = r.summary if (scope, d) == ("sdc", 36) else run_insertion(InsertionCase(segment="rsj", scope=scope, diameter_mm=d)).summary
+        s = r.summary if (scope, d) == ("sdc", 36) else run_insertion(InsertionCase(segment="rsj", scope=scope, diameter_mm=d,
+                                                                                       exit_length_mm=args.exit_length)).summary
         p = s["points_cm"]
         a = p["A"]["deformation_cm"] if p["A"] else None
         c = p["C"]["deformation_cm"] if p["C"] else None

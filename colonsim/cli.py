@@ -223,6 +223,8 @@ def _add_insert(sub):
     p.add_argument("--wall-thickness", type=float, default=2.0, help="colon wall thickness, mm (default 2, an assumption)")
     p.add_argument("--element-size", type=float, default=3.0, help="wall triangle size, mm (default 3)")
     p.add_argument("--material", help="material JSON from colonsim calibrate (default: the source's parameters)")
+    p.add_argument("--exit-length", type=float, default=0.0,
+                   help="RSJ only: mm of fixed colon after the sigmoid (default 0, SPEC.md's model)")
     p.add_argument("--vtu", action="store_true", help="write deformed meshes for ParaView (needs meshio)")
     p.add_argument("--snapshot-every", type=float, default=0.02, help="simulated seconds between VTU snapshots")
     p.add_argument("--threads", type=int, default=None,
@@ -287,7 +289,8 @@ def cmd_insert(args):
 
     cases = [InsertionCase(segment=args.segment, scope=scope, diameter_mm=args.diameter, angle_deg=args.angle,
                            friction=args.friction, wall_thickness_mm=args.wall_thickness,
-                           element_size_mm=args.element_size, material=args.material) for scope in args.scope]
+                           element_size_mm=args.element_size, material=args.material,
+                           exit_length_mm=args.exit_length) for scope in args.scope]
     if args.material is not None:
         from insertion.material import load_material
 

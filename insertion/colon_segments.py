@@ -215,9 +215,12 @@ def straight_colon(length, diameter, element_size, wall_thickness, fixed_length=
     )
 
 
-def rsj_centerline(rectum=0.04, radius=FLEXURE_RADIUS, angle_deg=180.0):
-    return Centerline([("straight", rectum, 0.0, "fixed", "rectum"),
-                       ("arc", radius, np.radians(angle_deg), "mobile", "sigmoid")])
+def rsj_centerline(rectum=0.04, radius=FLEXURE_RADIUS, angle_deg=180.0, exit_length=0.0):
+    pieces = [("straight", rectum, 0.0, "fixed", "rectum"),
+              ("arc", radius, np.radians(angle_deg), "mobile", "sigmoid")]
+    if exit_length > 0.0:
+        pieces.append(("straight", exit_length, 0.0, "fixed", "descending"))
+    return Centerline(pieces)
 
 
 def rsf_centerline(alpha_deg=0.0, rectum=0.04, sigmoid=0.20, descending=0.10, radius=FLEXURE_RADIUS):
@@ -244,8 +247,13 @@ def thf_centerline(beta_deg=0.0, lead_in=0.05, span=0.20, ascending=0.10, radius
 ANGLE_LIMIT_DEG = 60.0
 
 
-def colon_geometry(segment, diameter, angle_deg, element_size, wall_thickness) -> ColonGeometry:
-    """The geometry of ``segment`` ("rsj", "rsf", "thf", "thf-fixed", or "straight")."""
+def colon_geometry(segment, diameter, angle_deg, element_size, wall_thickness, exit_length=0.0) -> ColonGeometry:
+    """The geometry of ``segment`` ("rsj", "rsf", "thf", "thf-fixed", or "straight").
+
+    ``exit_length`` (m, RSJ only, default 0 = SPEC.md's model) continues the colon after the
+    sigmoid with a fixed straight piece (the start of the descending colon), so the tip passing
+    the fixed end enters fixed colon instead of leaving the tube.
+    """
     if segment == "straight":
         return straight_colon(0.20, diameter, element_size, wall_thickness)
     if segment not in ("rsj", "rsf", "thf", "thf-fixed"):
@@ -254,8 +262,12 @@ def colon_geometry(segment, diameter, angle_deg, element_size, wall_thickness) -
         raise ColonsimError(f"--angle {angle_deg:g} deg is outside 0-{ANGLE_LIMIT_DEG:g} deg, the range this geometry "
                             "builds (the source used 0, 30, 45)")
     up = np.array([0.0, 1.0, 0.0])
+    if not (np.isfinite(exit_length) and 0.0 <= exit_length <= 0.3):
+        raise ColonsimError(f"exit length {exit_length * 1e3:g} mm must lie in 0-300 mm")
     if segment == "rsj":
-        return _geometry("rsj", rsj_centerline(), diameter, element_size, wall_thickness, up)
+        c = rsj_centerline(exit_length=exit_length)
+        end = c.ends("sigmoid")[1] + 0.5 * diameter if exit_length > 0 else None
+        return _geometry("rsj", c, diameter, element_size, wall_thickness, up, end_depth=end)
     if segment == "rsf":
         c = rsf_centerline(angle_deg)
         return _geometry("rsf", c, diameter, element_size, wall_thickness, up,

@@ -87,6 +87,7 @@ class InsertionCase:
     push_speed: float = 0.6
     ramp_s: float = 0.05
     relax_s: float = 0.1
+    exit_length_mm: float = 0.0
     colon_damping: float = 60.0
     scope_damping: float = 5.0
     record_interval_s: float = 1e-3
@@ -108,6 +109,7 @@ class InsertionCase:
             ("time_step_factor", self.time_step_factor, 0.01, 1.0, "a safety factor in (0, 1]"),
             ("ramp_s", self.ramp_s, 0.0, 10.0, "ramp duration in s"),
             ("relax_s", self.relax_s, 0.0, 10.0, "relax duration in s"),
+            ("exit_length_mm", self.exit_length_mm, 0.0, 300.0, "RSJ exit length in mm (0: SPEC.md's model)"),
         ]
         for name, value, lo, hi, what in checks:
             if not (isinstance(value, (int, float)) and math.isfinite(value) and lo <= value <= hi):
@@ -158,7 +160,7 @@ def build_insertion(case: InsertionCase) -> Insertion:
     case.validate()
     D = case.diameter_mm * 1e-3
     geometry = colon_geometry(case.segment, D, case.angle_deg, case.element_size_mm * 1e-3,
-                              case.wall_thickness_mm * 1e-3)
+                              case.wall_thickness_mm * 1e-3, case.exit_length_mm * 1e-3)
     material = load_material(case.material or REFERENCE_MATERIAL_PATH)
     shell = Shell(geometry.nodes, geometry.triangles, case.wall_thickness_mm * 1e-3, material,
                   density=COLON_DENSITY, name="colon")

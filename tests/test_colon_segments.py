@@ -87,3 +87,11 @@ def test_mesh_sizes_next_to_the_source():
 def test_geometry_errors(args, message):
     with pytest.raises(ColonsimError, match=message):
         colon_geometry(*args, 3e-3, 2e-3)
+
+
+def test_rsj_exit_piece_continues_fixed_and_moves_the_end_of_the_run():
+    g = colon_geometry("rsj", 0.036, 0.0, 3e-3, 2e-3, exit_length=0.05)
+    c = rsj_centerline(exit_length=0.05)
+    assert c.length == pytest.approx(0.04 + np.pi * R + 0.05, rel=1e-12)
+    assert g.end_depth == pytest.approx(0.04 + np.pi * R + 0.018, rel=1e-12)  # tip past the sigmoid's end
+    assert g.fixed.sum() > colon_geometry("rsj", 0.036, 0.0, 3e-3, 2e-3).fixed.sum()
