@@ -24,14 +24,18 @@ from __future__ import annotations
 import hashlib
 import json
 import math
+import time
 from dataclasses import asdict, dataclass
 
 import numpy as np
 
 from colonsim.errors import ColonsimError
+from insertion.colon_segments import colon_geometry
 from insertion.contact import RodShellContact
-from insertion.manoeuvre import continuous_push, straighten_relax_push
+from insertion.manoeuvre import PushProfile, continuous_push, straighten_relax_push
 from insertion.material import REFERENCE_MATERIAL_PATH, load_material
+from insertion.outcomes import characteristic_points, quasi_static_fraction
+from insertion.recording import InsertionRecorder
 from insertion.scopes import colonoscope
 from insertion.shell import Shell
 from insertion.solver import ExplicitSolver, FixedNodes, LineConstraint, PrescribedVelocity
@@ -139,7 +143,7 @@ class Insertion:
     rod: object
     scope: object
     contact: RodShellContact
-    push: PushProfile | None
+    push: PushProfile
     solver: ExplicitSolver
     drive: PrescribedVelocity
     entry_point: np.ndarray
@@ -150,13 +154,8 @@ class Insertion:
     tip_end: float
 
 
-from insertion.manoeuvre import PushProfile  # noqa: E402  (type used above)
-
-
 def build_insertion(case: InsertionCase) -> Insertion:
     """Bodies, contact, constraints and manoeuvre of ``case`` (SI inside)."""
-    from insertion.colon_segments import colon_geometry
-
     case.validate()
     D = case.diameter_mm * 1e-3
     geometry = colon_geometry(case.segment, D, case.angle_deg, case.element_size_mm * 1e-3,
@@ -230,14 +229,10 @@ def run_insertion(case: InsertionCase, progress=None, snapshot_interval=None, ch
     snapshot_interval : float or None
         Simulated time between stored wall/scope positions (for VTU output), s.
     """
-    import time as _time
-
-    from insertion.recording import InsertionRecorder
-
-    t_build = _time.perf_counter()
+    t_build = time.perf_counter()
     model = build_insertion(case)
     recorder = InsertionRecorder(model, snapshot_interval)
-    t0 = _time.perf_counter()
+    t0 = time.perf_counter()
     duration = model.push.duration
     last_phase = model.push.phases[-1]
     ended_by = f"push depth cap {model.total_depth * 100:.1f} cm reached before the tip passed the fixed end"
@@ -252,7 +247,7 @@ def run_insertion(case: InsertionCase, progress=None, snapshot_interval=None, ch
         if model.solver.time >= last_phase.start and tip_arc >= model.tip_end:
             ended_by = "the tip passed the fixed end"
             break
-    wall = _time.perf_counter() - t0
+    wall = time.perf_counter() - t0
     frame = recorder.frame()
     summary = summarize(model, frame, wall, t0 - t_build)
     summary["ended_by"] = ended_by
@@ -261,8 +256,6 @@ def run_insertion(case: InsertionCase, progress=None, snapshot_interval=None, ch
 
 def summarize(model: Insertion, ts, wall_s, build_s) -> dict:
     """The summary of one run: deformation, points A/B/C, forces, energy check, sizes, inputs."""
-    from insertion.outcomes import characteristic_points, quasi_static_fraction
-
     points = characteristic_points(ts["time_s"], ts["depth_m"], ts["deformation_m"])
     qs = {body: quasi_static_fraction(ts[f"kinetic_{body}_J"], ts[f"internal_{body}_J"]) for body in ("colon", "scope")}
     g = model.geometry
