@@ -93,6 +93,52 @@ def _mr_stress(c00, c01, c11, C10, C01, C11):
     return w, s00, s01, s11
 
 
+@numba.njit(cache=True, inline="always")
+def _membrane_triangle(x, tri, dm_inv, vol, C10, C01, C11, e):
+    """Energy and forces of triangle ``e`` (volume ``vol``): (energy, ok, h1, h2) with h1, h2 the
+    force 3-vectors on its nodes 1 and 2 (node 0 gets -(h1 + h2)); ok False if det C <= 0."""
+    i0 = tri[e, 0]
+    i1 = tri[e, 1]
+    i2 = tri[e, 2]
+    # Ds = [x1 - x0, x2 - x0] (3x2); F = Ds Dm_inv
+    d10 = x[i1, 0] - x[i0, 0]
+    d11 = x[i1, 1] - x[i0, 1]
+    d12 = x[i1, 2] - x[i0, 2]
+    d20 = x[i2, 0] - x[i0, 0]
+    d21 = x[i2, 1] - x[i0, 1]
+    d22 = x[i2, 2] - x[i0, 2]
+    m00 = dm_inv[e, 0, 0]
+    m01 = dm_inv[e, 0, 1]
+    m10 = dm_inv[e, 1, 0]
+    m11 = dm_inv[e, 1, 1]
+    f00 = d10 * m00 + d20 * m10
+    f10 = d11 * m00 + d21 * m10
+    f20 = d12 * m00 + d22 * m10
+    f01 = d10 * m01 + d20 * m11
+    f11 = d11 * m01 + d21 * m11
+    f21 = d12 * m01 + d22 * m11
+    c00 = f00 * f00 + f10 * f10 + f20 * f20
+    c11 = f01 * f01 + f11 * f11 + f21 * f21
+    c01 = f00 * f01 + f10 * f11 + f20 * f21
+    if c00 * c11 - c01 * c01 <= 0.0:
+        return 0.0, False, (0.0, 0.0, 0.0), (0.0, 0.0, 0.0)
+    w, s00, s01, s11 = _mr_stress(c00, c01, c11, C10, C01, C11)
+    # P = F S (3x2); H = -vol P Dm_inv^T gives the forces on nodes 1 and 2.
+    p00 = f00 * s00 + f01 * s01
+    p01 = f00 * s01 + f01 * s11
+    p10 = f10 * s00 + f11 * s01
+    p11 = f10 * s01 + f11 * s11
+    p20 = f20 * s00 + f21 * s01
+    p21 = f20 * s01 + f21 * s11
+    h10 = -vol * (p00 * m00 + p01 * m01)
+    h11 = -vol * (p10 * m00 + p11 * m01)
+    h12 = -vol * (p20 * m00 + p21 * m01)
+    h20 = -vol * (p00 * m10 + p01 * m11)
+    h21 = -vol * (p10 * m10 + p11 * m11)
+    h22 = -vol * (p20 * m10 + p21 * m11)
+    return vol * w, True, (h10, h11, h12), (h20, h21, h22)
+
+
 @numba.njit(parallel=True, cache=True)
 def membrane_kernel(x, tri, dm_inv, area0, thickness, C10, C01, C11, elem_f):
     """Constant-strain Mooney-Rivlin membrane: per-triangle forces into ``elem_f`` (nt, 3, 3).
@@ -108,60 +154,14 @@ def membrane_kernel(x, tri, dm_inv, area0, thickness, C10, C01, C11, elem_f):
     energy = 0.0
     n_inverted = 0
     for e in numba.prange(nt):
-        i0 = tri[e, 0]
-        i1 = tri[e, 1]
-        i2 = tri[e, 2]
-        # Ds = [x1 - x0, x2 - x0] (3x2); F = Ds Dm_inv
-        d10 = x[i1, 0] - x[i0, 0]
-        d11 = x[i1, 1] - x[i0, 1]
-        d12 = x[i1, 2] - x[i0, 2]
-        d20 = x[i2, 0] - x[i0, 0]
-        d21 = x[i2, 1] - x[i0, 1]
-        d22 = x[i2, 2] - x[i0, 2]
-        m00 = dm_inv[e, 0, 0]
-        m01 = dm_inv[e, 0, 1]
-        m10 = dm_inv[e, 1, 0]
-        m11 = dm_inv[e, 1, 1]
-        f00 = d10 * m00 + d20 * m10
-        f10 = d11 * m00 + d21 * m10
-        f20 = d12 * m00 + d22 * m10
-        f01 = d10 * m01 + d20 * m11
-        f11 = d11 * m01 + d21 * m11
-        f21 = d12 * m01 + d22 * m11
-        c00 = f00 * f00 + f10 * f10 + f20 * f20
-        c11 = f01 * f01 + f11 * f11 + f21 * f21
-        c01 = f00 * f01 + f10 * f11 + f20 * f21
-        if c00 * c11 - c01 * c01 <= 0.0:
+        w, ok, h1, h2 = _membrane_triangle(x, tri, dm_inv, thickness * area0[e], C10, C01, C11, e)
+        if not ok:
             n_inverted += 1
-            for a in range(3):
-                for k in range(3):
-                    elem_f[e, a, k] = 0.0
-            continue
-        w, s00, s01, s11 = _mr_stress(c00, c01, c11, C10, C01, C11)
-        vol = thickness * area0[e]
-        energy += vol * w
-        # P = F S (3x2); H = -vol P Dm_inv^T gives the forces on nodes 1 and 2.
-        p00 = f00 * s00 + f01 * s01
-        p01 = f00 * s01 + f01 * s11
-        p10 = f10 * s00 + f11 * s01
-        p11 = f10 * s01 + f11 * s11
-        p20 = f20 * s00 + f21 * s01
-        p21 = f20 * s01 + f21 * s11
-        h10 = -vol * (p00 * m00 + p01 * m01)
-        h11 = -vol * (p10 * m00 + p11 * m01)
-        h12 = -vol * (p20 * m00 + p21 * m01)
-        h20 = -vol * (p00 * m10 + p01 * m11)
-        h21 = -vol * (p10 * m10 + p11 * m11)
-        h22 = -vol * (p20 * m10 + p21 * m11)
-        elem_f[e, 1, 0] = h10
-        elem_f[e, 1, 1] = h11
-        elem_f[e, 1, 2] = h12
-        elem_f[e, 2, 0] = h20
-        elem_f[e, 2, 1] = h21
-        elem_f[e, 2, 2] = h22
-        elem_f[e, 0, 0] = -(h10 + h20)
-        elem_f[e, 0, 1] = -(h11 + h21)
-        elem_f[e, 0, 2] = -(h12 + h22)
+        energy += w
+        for k in range(3):
+            elem_f[e, 1, k] = h1[k]
+            elem_f[e, 2, k] = h2[k]
+            elem_f[e, 0, k] = -(h1[k] + h2[k])
     return energy, n_inverted
 
 
@@ -273,14 +273,63 @@ def membrane_omega2_kernel(x, tri, dm_inv, thickness, density, C10, C01, C11, ma
 
 
 @numba.njit(cache=True, inline="always")
-def _hinge_geometry(x, a, b, c, d, g, h):
-    """Signed dihedral angle of hinge (a, b, c, d); its gradient goes to ``g[h]`` (4, 3).
+def _atan(t):
+    """Arctangent of t to about 1 ulp (Cephes atan, S. Moshier): rational approximation after a
+    reduction to |t| <= 0.66, without the slow correctly-rounded paths of libm's atan2, which
+    cost ~20 ns per call and made up a third of the hinge kernel."""
+    sign = 1.0
+    if t < 0.0:
+        sign = -1.0
+        t = -t
+    more_bits = 6.123233995736765886130e-17  # pi/2 - float(pi/2)
+    if t > 2.41421356237309504880:  # tan(3 pi / 8)
+        y = 0.5 * math.pi
+        corr = more_bits
+        t = -1.0 / t
+    elif t <= 0.66:
+        y = 0.0
+        corr = 0.0
+    else:
+        y = 0.25 * math.pi
+        corr = 0.5 * more_bits
+        t = (t - 1.0) / (t + 1.0)
+    z = t * t
+    p = (
+        (((-8.750608600031904122785e-1 * z - 1.615753718733365076637e1) * z - 7.500855792314704667340e1) * z
+         - 1.228866684490136173410e2) * z
+        - 6.485021904942025371773e1
+    )
+    q = (
+        ((((z + 2.485846490142306297962e1) * z + 1.650270098316988542046e2) * z + 4.328810604912902668951e2) * z
+         + 4.853903996359136964868e2) * z
+        + 1.945506571482613964425e2
+    )
+    z = t * (z * p / q) + t
+    return sign * (y + (z + corr))
+
+
+@numba.njit(cache=True, inline="always")
+def _atan2(y, x):
+    """atan2(y, x) through :func:`_atan` (same quadrants and signed zeros as math.atan2); x = 0
+    and NaN go to math.atan2."""
+    if x > 0.0:
+        return _atan(y / x)
+    if x < 0.0:
+        return _atan(y / x) + math.copysign(math.pi, y)
+    return math.atan2(y, x)
+
+
+@numba.njit(cache=True, inline="always")
+def _hinge_gradient(x, a, b, c, d):
+    """Signed dihedral angle of hinge (a, b, c, d) and its gradient.
 
     theta = atan2((n1 x n2) . e_hat, n1 . n2), n1 = e x (x_c - x_a), n2 = (x_d - x_a) x e,
     e = x_b - x_a. Zero for a flat hinge; the standard gradient
     d theta/d x_c = -|e| n1 / |n1|^2, d theta/d x_d = -|e| n2 / |n2|^2 and the edge nodes'
-    shares from the projections of x_c, x_d on the edge (translation invariance).
-    Returns (theta, ok) with ok False for a zero-area triangle (gradient then undefined).
+    shares from the projections of x_c, x_d on the edge (translation invariance):
+    d theta/d x_a = -(1 - al1) g_c - (1 - al2) g_d, d theta/d x_b = -al1 g_c - al2 g_d.
+    Returns (theta, ok, g_c, g_d, al1, al2) with ok False for a zero-area triangle (gradient then
+    undefined).
     """
     e0 = x[b, 0] - x[a, 0]
     e1 = x[b, 1] - x[a, 1]
@@ -301,8 +350,9 @@ def _hinge_geometry(x, a, b, c, d, g, h):
     ee = e0 * e0 + e1 * e1 + e2 * e2
     nn1 = n10 * n10 + n11 * n11 + n12 * n12
     nn2 = n20 * n20 + n21 * n21 + n22 * n22
+    zero = (0.0, 0.0, 0.0)
     if not (nn1 > 0.0 and nn2 > 0.0 and ee > 0.0):
-        return 0.0, False
+        return 0.0, False, zero, zero, 0.0, 0.0
     le = math.sqrt(ee)
     # (n1 x n2) . e / |e| and n1 . n2
     cx0 = n11 * n22 - n12 * n21
@@ -310,30 +360,25 @@ def _hinge_geometry(x, a, b, c, d, g, h):
     cx2 = n10 * n21 - n11 * n20
     sin_part = (cx0 * e0 + cx1 * e1 + cx2 * e2) / le
     cos_part = n10 * n20 + n11 * n21 + n12 * n22
-    theta = math.atan2(sin_part, cos_part)
+    theta = _atan2(sin_part, cos_part)
     s1 = -le / nn1
     s2 = -le / nn2
-    gc0 = s1 * n10
-    gc1 = s1 * n11
-    gc2 = s1 * n12
-    gd0 = s2 * n20
-    gd1 = s2 * n21
-    gd2 = s2 * n22
     al1 = (u0 * e0 + u1 * e1 + u2 * e2) / ee
     al2 = (v0 * e0 + v1 * e1 + v2 * e2) / ee
-    g[h, 2, 0] = gc0
-    g[h, 2, 1] = gc1
-    g[h, 2, 2] = gc2
-    g[h, 3, 0] = gd0
-    g[h, 3, 1] = gd1
-    g[h, 3, 2] = gd2
-    g[h, 0, 0] = -(1.0 - al1) * gc0 - (1.0 - al2) * gd0
-    g[h, 0, 1] = -(1.0 - al1) * gc1 - (1.0 - al2) * gd1
-    g[h, 0, 2] = -(1.0 - al1) * gc2 - (1.0 - al2) * gd2
-    g[h, 1, 0] = -al1 * gc0 - al2 * gd0
-    g[h, 1, 1] = -al1 * gc1 - al2 * gd1
-    g[h, 1, 2] = -al1 * gc2 - al2 * gd2
-    return theta, True
+    return theta, True, (s1 * n10, s1 * n11, s1 * n12), (s2 * n20, s2 * n21, s2 * n22), al1, al2
+
+
+@numba.njit(cache=True, inline="always")
+def _hinge_geometry(x, a, b, c, d, g, h):
+    """Signed dihedral angle of hinge (a, b, c, d) (see :func:`_hinge_gradient`); its gradient
+    goes to ``g[h]`` (4, 3). Returns (theta, ok)."""
+    theta, ok, gc, gd, al1, al2 = _hinge_gradient(x, a, b, c, d)
+    for k in range(3):
+        g[h, 2, k] = gc[k]
+        g[h, 3, k] = gd[k]
+        g[h, 0, k] = -(1.0 - al1) * gc[k] - (1.0 - al2) * gd[k]
+        g[h, 1, k] = -al1 * gc[k] - al2 * gd[k]
+    return theta, ok
 
 
 @numba.njit(parallel=True, cache=True)
@@ -374,6 +419,84 @@ def hinge_kernel(x, hinge, stiffness, theta0, elem_f):
             for k in range(3):
                 elem_f[h, a, k] *= coef
     return energy, n_bad
+
+
+@numba.njit(parallel=True, cache=True)
+def internal_forces_kernel(x, tri, dm_inv, area0, thickness, C10, C01, C11, hinge, stiffness, theta0, out, zero,
+                           energy, count):
+    """Membrane and hinge forces in one parallel region, scattered straight onto nodes.
+
+    The elements are split into ``out.shape[0]`` contiguous chunks, one per thread; chunk ``c``
+    adds the forces of its triangles and hinges into its own nodal array ``out[c]`` (n, 3), so no
+    two threads write the same memory. With one chunk ``out`` can be a view of the force array
+    itself and no gather is needed; with several, :func:`sum_chunks` adds them up. This replaces
+    two element kernels and two gathers (four fork/joins and a 4 MB buffer round trip per step).
+
+    Parameters
+    ----------
+    out : (n_chunks, n, 3) float64
+        Per-chunk nodal forces, added to (set to zero first if ``zero``).
+    energy : (n_chunks, 2) float64
+        Membrane and bending strain energy of each chunk, J (written).
+    count : (n_chunks, 2) int64
+        Inverted triangles and collapsed hinges of each chunk (written).
+    """
+    n_chunks = out.shape[0]
+    nt = tri.shape[0]
+    nh = hinge.shape[0]
+    for c in numba.prange(n_chunks):
+        f = out[c]
+        if zero:
+            f[:, :] = 0.0
+        e_mem = 0.0
+        n_inv = 0
+        for e in range(c * nt // n_chunks, (c + 1) * nt // n_chunks):
+            w, ok, h1, h2 = _membrane_triangle(x, tri, dm_inv, thickness * area0[e], C10, C01, C11, e)
+            if not ok:
+                n_inv += 1
+            e_mem += w
+            i0 = tri[e, 0]
+            i1 = tri[e, 1]
+            i2 = tri[e, 2]
+            for k in range(3):
+                f[i1, k] += h1[k]
+                f[i2, k] += h2[k]
+                f[i0, k] += -(h1[k] + h2[k])
+        e_bend = 0.0
+        n_bad = 0
+        for h in range(c * nh // n_chunks, (c + 1) * nh // n_chunks):
+            a = hinge[h, 0]
+            b = hinge[h, 1]
+            cc = hinge[h, 2]
+            d = hinge[h, 3]
+            theta, ok, gc, gd, al1, al2 = _hinge_gradient(x, a, b, cc, d)
+            if not ok:
+                n_bad += 1
+                continue
+            dth = theta - theta0[h]
+            e_bend += stiffness[h] * dth * dth
+            coef = -2.0 * stiffness[h] * dth
+            for k in range(3):
+                f[cc, k] += gc[k] * coef
+                f[d, k] += gd[k] * coef
+                f[a, k] += (-(1.0 - al1) * gc[k] - (1.0 - al2) * gd[k]) * coef
+                f[b, k] += (-al1 * gc[k] - al2 * gd[k]) * coef
+        energy[c, 0] = e_mem
+        energy[c, 1] = e_bend
+        count[c, 0] = n_inv
+        count[c, 1] = n_bad
+
+
+@numba.njit(parallel=True, cache=True)
+def sum_chunks(out, f):
+    """Add the per-chunk nodal forces ``out`` (n_chunks, n, 3) into ``f`` (n, 3)."""
+    n_chunks = out.shape[0]
+    for i in numba.prange(f.shape[0]):
+        for k in range(3):
+            s = 0.0
+            for c in range(n_chunks):
+                s += out[c, i, k]
+            f[i, k] += s
 
 
 @numba.njit(parallel=True, cache=True)
@@ -553,6 +676,9 @@ class Shell:
         self._omega2 = np.zeros(len(triangles))
         self._node_tmp = np.zeros((len(nodes), 3))
         self._mass_scale = np.ones(len(nodes))
+        self._chunk_f = np.zeros((0,) + nodes.shape)  # per-thread nodal forces, sized on first use
+        self._chunk_energy = np.zeros((0, 2))
+        self._chunk_count = np.zeros((0, 2), dtype=np.int64)
 
     @property
     def n_nodes(self):
@@ -595,8 +721,39 @@ class Shell:
         return energy
 
     def internal_forces(self, x, f):
-        """Add internal elastic forces (-dE/dx) for positions x into f (n, 3); return strain energy, J."""
-        return self.membrane_forces(x, f) + self.bending_forces(x, f)
+        """Add internal elastic forces (-dE/dx) for positions x into f (n, 3); return strain energy, J.
+
+        The sum of :meth:`membrane_forces` and :meth:`bending_forces` (up to rounding), computed
+        by one fused kernel.
+        """
+        self._check_x(x)
+        m = self.material
+        n_chunks = numba.get_num_threads()
+        if self._chunk_energy.shape[0] != n_chunks:
+            self._chunk_f = np.zeros((n_chunks,) + x.shape)
+            self._chunk_energy = np.zeros((n_chunks, 2))
+            self._chunk_count = np.zeros((n_chunks, 2), dtype=np.int64)
+        # one chunk adds straight into f (a view), several into their own arrays summed below
+        direct = n_chunks == 1 and f.dtype == np.float64 and f.flags.c_contiguous and f.shape == x.shape
+        out = f.reshape((1,) + f.shape) if direct else self._chunk_f
+        internal_forces_kernel(
+            x, self.triangles, self.dm_inv, self.area0, self.thickness, m.C10, m.C01, m.C11,
+            self.hinges, self.hinge_stiffness, self.theta0, out, not direct, self._chunk_energy, self._chunk_count,
+        )
+        n_inv, n_bad = self._chunk_count.sum(axis=0)
+        if n_inv:
+            raise ColonsimError(
+                f"{n_inv} wall triangle(s) of '{self.name}' are inverted or collapsed (det C <= 0); "
+                "the simulation diverged: reduce the time step or the loading rate."
+            )
+        if n_bad:
+            raise ColonsimError(
+                f"{n_bad} bending hinge(s) of '{self.name}' have a collapsed triangle; "
+                "the simulation diverged: reduce the time step or the loading rate."
+            )
+        if not direct:
+            sum_chunks(out, f)
+        return float(self._chunk_energy.sum())
 
     def pressure_forces(self, x, pressure, f):
         """Add the follower load of an internal pressure (Pa, positive pushes along the outward
