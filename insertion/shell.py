@@ -276,24 +276,18 @@ def membrane_omega2_kernel(x, tri, dm_inv, thickness, density, C10, C01, C11, ma
 def _atan(t):
     """Arctangent of t to about 1 ulp (Cephes atan, S. Moshier): rational approximation after a
     reduction to |t| <= 0.66, without the slow correctly-rounded paths of libm's atan2, which
-    cost ~20 ns per call and made up a third of the hinge kernel."""
-    sign = 1.0
-    if t < 0.0:
-        sign = -1.0
-        t = -t
+    cost ~20 ns per call and made up a third of the hinge kernel. Written with selects rather
+    than branches so that a loop over many angles runs them side by side."""
+    a = abs(t)
+    big = a > 2.41421356237309504880  # tan(3 pi / 8)
+    mid = a > 0.66
     more_bits = 6.123233995736765886130e-17  # pi/2 - float(pi/2)
-    if t > 2.41421356237309504880:  # tan(3 pi / 8)
-        y = 0.5 * math.pi
-        corr = more_bits
-        t = -1.0 / t
-    elif t <= 0.66:
-        y = 0.0
-        corr = 0.0
-    else:
-        y = 0.25 * math.pi
-        corr = 0.5 * more_bits
-        t = (t - 1.0) / (t + 1.0)
-    z = t * t
+    num = -1.0 if big else (a - 1.0 if mid else a)
+    den = a if big else (a + 1.0 if mid else 1.0)
+    y = 0.5 * math.pi if big else (0.25 * math.pi if mid else 0.0)
+    corr = more_bits if big else (0.5 * more_bits if mid else 0.0)
+    r = num / den
+    z = r * r
     p = (
         (((-8.750608600031904122785e-1 * z - 1.615753718733365076637e1) * z - 7.500855792314704667340e1) * z
          - 1.228866684490136173410e2) * z
@@ -304,8 +298,8 @@ def _atan(t):
          + 4.853903996359136964868e2) * z
         + 1.945506571482613964425e2
     )
-    z = t * (z * p / q) + t
-    return sign * (y + (z + corr))
+    z = r * (z * p / q) + r
+    return math.copysign(y + (z + corr), t)
 
 
 @numba.njit(cache=True, inline="always")
@@ -320,16 +314,16 @@ def _atan2(y, x):
 
 
 @numba.njit(cache=True, inline="always")
-def _hinge_gradient(x, a, b, c, d):
-    """Signed dihedral angle of hinge (a, b, c, d) and its gradient.
+def _hinge_terms(x, a, b, c, d):
+    """Arguments of the signed dihedral angle of hinge (a, b, c, d) and its gradient.
 
     theta = atan2((n1 x n2) . e_hat, n1 . n2), n1 = e x (x_c - x_a), n2 = (x_d - x_a) x e,
     e = x_b - x_a. Zero for a flat hinge; the standard gradient
     d theta/d x_c = -|e| n1 / |n1|^2, d theta/d x_d = -|e| n2 / |n2|^2 and the edge nodes'
     shares from the projections of x_c, x_d on the edge (translation invariance):
     d theta/d x_a = -(1 - al1) g_c - (1 - al2) g_d, d theta/d x_b = -al1 g_c - al2 g_d.
-    Returns (theta, ok, g_c, g_d, al1, al2) with ok False for a zero-area triangle (gradient then
-    undefined).
+    Returns (sin_part, cos_part, ok, g_c, g_d, al1, al2), theta = atan2(sin_part, cos_part), with
+    ok False for a zero-area triangle (gradient then undefined).
     """
     e0 = x[b, 0] - x[a, 0]
     e1 = x[b, 1] - x[a, 1]
@@ -352,7 +346,7 @@ def _hinge_gradient(x, a, b, c, d):
     nn2 = n20 * n20 + n21 * n21 + n22 * n22
     zero = (0.0, 0.0, 0.0)
     if not (nn1 > 0.0 and nn2 > 0.0 and ee > 0.0):
-        return 0.0, False, zero, zero, 0.0, 0.0
+        return 0.0, 1.0, False, zero, zero, 0.0, 0.0
     le = math.sqrt(ee)
     # (n1 x n2) . e / |e| and n1 . n2
     cx0 = n11 * n22 - n12 * n21
@@ -360,12 +354,19 @@ def _hinge_gradient(x, a, b, c, d):
     cx2 = n10 * n21 - n11 * n20
     sin_part = (cx0 * e0 + cx1 * e1 + cx2 * e2) / le
     cos_part = n10 * n20 + n11 * n21 + n12 * n22
-    theta = _atan2(sin_part, cos_part)
     s1 = -le / nn1
     s2 = -le / nn2
     al1 = (u0 * e0 + u1 * e1 + u2 * e2) / ee
     al2 = (v0 * e0 + v1 * e1 + v2 * e2) / ee
-    return theta, True, (s1 * n10, s1 * n11, s1 * n12), (s2 * n20, s2 * n21, s2 * n22), al1, al2
+    return sin_part, cos_part, True, (s1 * n10, s1 * n11, s1 * n12), (s2 * n20, s2 * n21, s2 * n22), al1, al2
+
+
+@numba.njit(cache=True, inline="always")
+def _hinge_gradient(x, a, b, c, d):
+    """Signed dihedral angle of hinge (a, b, c, d) and its gradient (see :func:`_hinge_terms`):
+    (theta, ok, g_c, g_d, al1, al2)."""
+    sin_part, cos_part, ok, gc, gd, al1, al2 = _hinge_terms(x, a, b, c, d)
+    return _atan2(sin_part, cos_part), ok, gc, gd, al1, al2
 
 
 @numba.njit(cache=True, inline="always")
@@ -421,6 +422,9 @@ def hinge_kernel(x, hinge, stiffness, theta0, elem_f):
     return energy, n_bad
 
 
+_HINGE_BLOCK = 64  # hinges per block of the fused kernel (scratch stays in L1)
+
+
 @numba.njit(parallel=True, cache=True)
 def internal_forces_kernel(x, tri, dm_inv, area0, thickness, C10, C01, C11, hinge, stiffness, theta0, out, zero,
                            energy, count):
@@ -462,25 +466,58 @@ def internal_forces_kernel(x, tri, dm_inv, area0, thickness, C10, C01, C11, hing
                 f[i1, k] += h1[k]
                 f[i2, k] += h2[k]
                 f[i0, k] += -(h1[k] + h2[k])
+        # Hinges in blocks: the angle arguments and gradients of a block first, then all its
+        # arctangents in one tight loop (one long dependency chain each, which a loop of whole
+        # hinges cannot overlap), then the forces.
         e_bend = 0.0
         n_bad = 0
-        for h in range(c * nh // n_chunks, (c + 1) * nh // n_chunks):
-            a = hinge[h, 0]
-            b = hinge[h, 1]
-            cc = hinge[h, 2]
-            d = hinge[h, 3]
-            theta, ok, gc, gd, al1, al2 = _hinge_gradient(x, a, b, cc, d)
-            if not ok:
-                n_bad += 1
-                continue
-            dth = theta - theta0[h]
-            e_bend += stiffness[h] * dth * dth
-            coef = -2.0 * stiffness[h] * dth
-            for k in range(3):
-                f[cc, k] += gc[k] * coef
-                f[d, k] += gd[k] * coef
-                f[a, k] += (-(1.0 - al1) * gc[k] - (1.0 - al2) * gd[k]) * coef
-                f[b, k] += (-al1 * gc[k] - al2 * gd[k]) * coef
+        ys = np.empty(_HINGE_BLOCK)
+        xs = np.empty(_HINGE_BLOCK)
+        th = np.empty(_HINGE_BLOCK)
+        g = np.empty((_HINGE_BLOCK, 9))
+        h_end = (c + 1) * nh // n_chunks
+        for start in range(c * nh // n_chunks, h_end, _HINGE_BLOCK):
+            nb = min(_HINGE_BLOCK, h_end - start)
+            for j in range(nb):
+                h = start + j
+                sin_part, cos_part, ok, gc, gd, al1, al2 = _hinge_terms(
+                    x, hinge[h, 0], hinge[h, 1], hinge[h, 2], hinge[h, 3]
+                )
+                ys[j] = sin_part
+                xs[j] = cos_part
+                for k in range(3):
+                    g[j, k] = gc[k]
+                    g[j, 3 + k] = gd[k]
+                g[j, 6] = al1
+                g[j, 7] = al2
+                g[j, 8] = 1.0 if ok else 0.0
+            for j in range(nb):  # _atan2 without its branches
+                t = _atan(ys[j] / xs[j])
+                th[j] = t + math.copysign(math.pi, ys[j]) if xs[j] < 0.0 else t
+            for j in range(nb):
+                h = start + j
+                if g[j, 8] == 0.0:
+                    n_bad += 1
+                    continue
+                theta = th[j]
+                if not (xs[j] > 0.0 or xs[j] < 0.0):  # cos_part 0 or NaN: as _atan2 does
+                    theta = math.atan2(ys[j], xs[j])
+                dth = theta - theta0[h]
+                e_bend += stiffness[h] * dth * dth
+                coef = -2.0 * stiffness[h] * dth
+                a = hinge[h, 0]
+                b = hinge[h, 1]
+                cc = hinge[h, 2]
+                d = hinge[h, 3]
+                al1 = g[j, 6]
+                al2 = g[j, 7]
+                for k in range(3):
+                    gc = g[j, k]
+                    gd = g[j, 3 + k]
+                    f[cc, k] += gc * coef
+                    f[d, k] += gd * coef
+                    f[a, k] += (-(1.0 - al1) * gc - (1.0 - al2) * gd) * coef
+                    f[b, k] += (-al1 * gc - al2 * gd) * coef
         energy[c, 0] = e_mem
         energy[c, 1] = e_bend
         count[c, 0] = n_inv
