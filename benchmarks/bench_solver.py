@@ -9,7 +9,10 @@ per-step time, element updates per second per core
 ((triangles + hinges + rod segments + contact candidates) * steps / wall / cores) and the
 projected wall time of a 0.5 s simulated push at the solver's time step.
 
-Run: ``python benchmarks/bench_solver.py [--steps 2000] [--threads 2] [--mesh 3e-3] [--rod-spacing 5e-3]``
+Run: ``python benchmarks/bench_solver.py [--steps 2000] [--threads 2] [--mesh 3e-3] [--rod-spacing 5e-3] [--repeat 1]``
+
+On a shared machine single timings vary by +-15 %: ``--repeat 5`` times five runs of ``--steps``
+steps each (one model, continuing in time) and reports the median.
 """
 
 import argparse
@@ -64,6 +67,7 @@ def main():
     parser.add_argument("--push", type=float, default=0.5, help="simulated push duration to project, s")
     parser.add_argument("--mesh", type=float, default=3e-3, help="wall triangle size, m")
     parser.add_argument("--rod-spacing", type=float, default=5e-3, help="scope node spacing, m")
+    parser.add_argument("--repeat", type=int, default=1, help="timed runs of --steps steps; the median is reported")
     args = parser.parse_args()
     if args.threads:
         numba.set_num_threads(args.threads)
@@ -87,14 +91,18 @@ def main():
         return energy
 
     colon.internal_forces = timed_shell_forces
-    cand = 0
-    t0 = time.perf_counter()
-    for _ in range(args.steps):
-        sim.advance()
-        cand += contact.n_candidates
-    wall = time.perf_counter() - t0
+    runs = []  # (wall, candidates, shell time) of each timed run
+    for _ in range(max(args.repeat, 1)):
+        cand = 0
+        shell_time[0] = 0.0
+        t0 = time.perf_counter()
+        for _ in range(args.steps):
+            sim.advance()
+            cand += contact.n_candidates
+        runs.append((time.perf_counter() - t0, cand, shell_time[0]))
     colon.internal_forces = shell_forces
-    shell_share = shell_time[0] / wall
+    wall, cand, shell_wall = sorted(runs)[len(runs) // 2]
+    shell_share = shell_wall / wall
 
     per_step = wall / args.steps
     updates = (elements * args.steps + cand) / wall / cores
@@ -110,6 +118,9 @@ def main():
           f"wall internal forces ~{100 * shell_share:.0f} % of it")
     print(f"element updates per second per core: {updates / 1e6:.1f} M")
     print(f"projected wall time of a {args.push} s push: {steps_push * per_step:.0f} s")
+    if len(runs) > 1:
+        print(f"per step in each of the {len(runs)} runs (median reported above): "
+              + ", ".join(f"{w / args.steps * 1e3:.3f}" for w, _, _ in runs) + " ms")
     print(f"candidate rebuilds: {contact.n_rebuilds}; tip at x = {sim.state['scope'].x[scope.tip_node, 0]:.4f} m")
 
 
