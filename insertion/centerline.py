@@ -1,0 +1,445 @@
+"""Colon centerlines made of straight pieces and circular arcs, arc-length parametrised (SI, m).
+
+A centerline is a chain of pieces, each tagged ``"fixed"`` (retroperitoneal, held in place) or
+``"mobile"`` (intraperitoneal) and named after its colon segment. Pieces are given as
+:class:`Straight`, :class:`Arc` and :class:`Kink`; a kink between two straight pieces becomes a
+fillet arc of radius ``fillet_radius`` (**assumption** of SPEC.md 2.1, so the tube has no crease),
+trimming ``R_f tan(|angle|/2)`` off each neighbour.
+
+Fillet rule (**assumption**): a fillet is fixed when either neighbour is fixed (the attachment
+of the fixed segment reaches the junction), mobile only between two mobile pieces. It takes the
+neighbours' name when both share one (the bottom of the transverse V) and ``"a-b fillet"`` else.
+
+Frames are rotation-minimising (parallel transport): the normal ``n`` never spins about the
+tangent, so rings of a tube mesh placed with ``(n, b)`` do not twist. On a planar centerline
+``n`` stays in the plane and ``b = t x n`` is the plane normal. An arc bends towards
+``cos(roll) n + sin(roll) b`` of the transported frame at its start (``roll = 0``: in the plane,
+positive angle towards ``+n``), which is how a 3-D centerline is built.
+
+The model builders (:func:`rsj_centerline`, :func:`rsf_centerline`, :func:`thf_centerline`,
+:func:`thf_fixed_centerline`) are planar in the x-y plane, start at the origin heading ``+y`` with
+``n = -x`` (positive turns are counter-clockwise seen from ``+z``). Readings of SPEC.md 2.1
+(**assumptions**) are in their docstrings.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from colonsim.errors import ColonsimError
+
+FLEXURE_RADIUS = 0.05  # m, SPEC.md 2.1 (flexures and the RSJ sigmoid arc)
+FILLET_RADIUS = 0.05  # m, assumption: same as the flexures, the gentlest bend the anatomy shows
+MAX_LENGTH = 2.0  # m, a whole adult colon is about 1.5 m; longer pieces are typing errors
+TAGS = ("fixed", "mobile")
+
+
+@dataclass(frozen=True)
+class Straight:
+    """Straight piece of ``length`` m."""
+
+    length: float
+    tag: str
+    name: str
+
+
+@dataclass(frozen=True)
+class Arc:
+    """Circular arc of ``radius`` m turning the tangent by ``angle`` rad (sign: side, see module)."""
+
+    radius: float
+    angle: float
+    tag: str
+    name: str
+    roll: float = 0.0
+
+
+@dataclass(frozen=True)
+class Kink:
+    """Change of direction by ``angle`` rad between two straight pieces, rounded by a fillet.
+
+    ``fillet_radius`` None takes the centerline's default.
+    """
+
+    angle: float
+    roll: float = 0.0
+    fillet_radius: float | None = None
+
+
+def _check_length(what, value, upper=MAX_LENGTH):
+    if not (np.isfinite(value) and 0.0 < value <= upper):
+        raise ColonsimError(f"{what} = {value!r} m must be a positive length up to {upper:g} m; fix it.")
+
+
+def _check_tag(piece):
+    if piece.tag not in TAGS:
+        raise ColonsimError(f"piece {piece.name!r} has tag {piece.tag!r}; use 'fixed' or 'mobile'.")
+
+
+def _unit(v):
+    v = np.asarray(v, dtype=float)
+    return v / np.linalg.norm(v)
+
+
+def _rotate(v, axis, angle):
+    """Rodrigues rotation of vectors ``v`` (k, 3) about unit ``axis`` (3,) by ``angle`` (k,) rad."""
+    c, s = np.cos(angle)[:, None], np.sin(angle)[:, None]
+    return v * c + np.cross(axis, v) * s + axis * (v @ axis)[:, None] * (1.0 - c)
+
+
+def resolve_pieces(pieces, fillet_radius=FILLET_RADIUS):
+    """Replace kinks by fillet arcs and trim the straight pieces next to them.
+
+    Parameters
+    ----------
+    pieces : sequence of Straight, Arc, Kink
+    fillet_radius : float
+        Default fillet radius, m.
+
+    Returns
+    -------
+    list of Straight and Arc
+        Zero-angle kinks are dropped; straights trimmed to zero length are dropped.
+    """
+    _check_length("fillet radius", fillet_radius)
+    items = list(pieces)
+    if not items:
+        raise ColonsimError("a centerline needs at least one piece; give a Straight or an Arc.")
+    for i, piece in enumerate(items):
+        if isinstance(piece, Straight):
+            _check_tag(piece)
+            _check_length(f"length of {piece.name}", piece.length)
+        elif isinstance(piece, Arc):
+            _check_tag(piece)
+            _check_length(f"radius of {piece.name}", piece.radius)
+            if not (np.isfinite(piece.angle) and 0.0 < abs(piece.angle) <= 2.0 * np.pi):
+                raise ColonsimError(
+                    f"arc {piece.name!r} turns {np.degrees(piece.angle):g} deg; give a non-zero angle up to 360 deg."
+                )
+        elif isinstance(piece, Kink):
+            if not (0 < i < len(items) - 1 and isinstance(items[i - 1], Straight)
+                    and isinstance(items[i + 1], Straight)):
+                raise ColonsimError("a Kink must sit between two Straight pieces; use an Arc next to an arc.")
+            if not (np.isfinite(piece.angle) and abs(piece.angle) < np.pi):
+                raise ColonsimError(
+                    f"a kink of {np.degrees(piece.angle):g} deg folds the colon back on itself; "
+                    "keep kinks below 180 deg."
+                )
+        else:
+            raise ColonsimError(f"{piece!r} is not a centerline piece; use Straight, Arc or Kink.")
+
+    # Trim lengths first: a straight between two kinks loses a tangent length at each end.
+    trim = np.zeros(len(items))
+    radius_of = {}
+    for i, piece in enumerate(items):
+        if isinstance(piece, Kink) and piece.angle != 0.0:
+            rf = fillet_radius if piece.fillet_radius is None else piece.fillet_radius
+            _check_length(f"fillet radius at the kink after {items[i - 1].name}", rf)
+            radius_of[i] = rf
+            cut = rf * np.tan(0.5 * abs(piece.angle))
+            trim[i - 1] += cut
+            trim[i + 1] += cut
+    for i, piece in enumerate(items):
+        if isinstance(piece, Straight) and trim[i] > piece.length * (1.0 + 1e-12):
+            raise ColonsimError(
+                f"the fillets next to {piece.name} need {trim[i] * 100:.2f} cm of it but it is only "
+                f"{piece.length * 100:.2f} cm long; reduce the fillet radius or the angle."
+            )
+
+    out = []
+    for i, piece in enumerate(items):
+        if isinstance(piece, Straight):
+            length = piece.length - trim[i]
+            if length > 1e-12:
+                out.append(Straight(length, piece.tag, piece.name))
+        elif isinstance(piece, Kink):
+            if piece.angle == 0.0:
+                continue
+            before, after = items[i - 1], items[i + 1]
+            tag = "fixed" if "fixed" in (before.tag, after.tag) else "mobile"
+            name = before.name if before.name == after.name else f"{before.name}-{after.name} fillet"
+            out.append(Arc(radius_of[i], piece.angle, tag, name, piece.roll))
+        else:
+            out.append(piece)
+    # Two straights with nothing between them (a zero kink) are one piece of the same segment.
+    merged = []
+    for piece in out:
+        prev = merged[-1] if merged else None
+        if (isinstance(piece, Straight) and isinstance(prev, Straight)
+                and (prev.tag, prev.name) == (piece.tag, piece.name)):
+            merged[-1] = Straight(prev.length + piece.length, piece.tag, piece.name)
+        else:
+            merged.append(piece)
+    return merged
+
+
+class Centerline:
+    """Arc-length parametrised chain of straight and arc pieces (m), with a parallel-transport frame.
+
+    Parameters
+    ----------
+    pieces : sequence of Straight, Arc, Kink
+        Kinks become fillet arcs (see :func:`resolve_pieces`).
+    fillet_radius : float
+        Default fillet radius, m.
+    start : (3,) float
+        Position at s = 0, m.
+    tangent, normal : (3,) float
+        Direction of travel and normal at s = 0; ``normal`` is made orthogonal to ``tangent``.
+
+    Attributes
+    ----------
+    pieces : list of Straight and Arc
+        The resolved pieces (fillets included).
+    s_start, s_end : (np,) float
+        Arc length at the start and end of each piece, m.
+    length : float
+        Total arc length, m.
+    """
+
+    def __init__(self, pieces, fillet_radius=FILLET_RADIUS, start=(0.0, 0.0, 0.0),
+                 tangent=(0.0, 1.0, 0.0), normal=(-1.0, 0.0, 0.0)):
+        self.pieces = resolve_pieces(pieces, fillet_radius)
+        t = _unit(tangent)
+        n = np.asarray(normal, dtype=float)
+        n = _unit(n - (n @ t) * t)
+        p = np.asarray(start, dtype=float).copy()
+        s = 0.0
+        # Per piece: start point, tangent, normal, bending direction d and rotation axis w = t x d.
+        self._p0, self._t0, self._n0, self._d, self._w = [], [], [], [], []
+        s_start, s_end = [], []
+        for piece in self.pieces:
+            b = np.cross(t, n)
+            if isinstance(piece, Straight):
+                length, d = piece.length, np.zeros(3)
+            else:
+                length = piece.radius * abs(piece.angle)
+                d = np.sign(piece.angle) * (np.cos(piece.roll) * n + np.sin(piece.roll) * b)
+            self._p0.append(p.copy())
+            self._t0.append(t.copy())
+            self._n0.append(n.copy())
+            self._d.append(d)
+            self._w.append(np.cross(t, d))
+            s_start.append(s)
+            s_end.append(s + length)
+            p, t, n = self._local(len(s_start) - 1, np.array([length]))[:3]
+            p, t, n = p[0], _unit(t[0]), n[0]
+            n = _unit(n - (n @ t) * t)  # keep the frame orthonormal to round-off over many pieces
+            s += length
+        self.s_start = np.array(s_start)
+        self.s_end = np.array(s_end)
+        self.length = float(s)
+
+    def _local(self, i, sigma):
+        """Position, tangent and normal at distance ``sigma`` (k,) into piece ``i``."""
+        piece = self.pieces[i]
+        p0, t0, n0 = self._p0[i], self._t0[i], self._n0[i]
+        if isinstance(piece, Straight):
+            k = len(sigma)
+            return p0 + sigma[:, None] * t0, np.tile(t0, (k, 1)), np.tile(n0, (k, 1))
+        theta = sigma / piece.radius
+        c, s = np.cos(theta)[:, None], np.sin(theta)[:, None]
+        d = self._d[i]
+        pos = p0 + piece.radius * (s * t0 + (1.0 - c) * d)
+        tan = c * t0 + s * d
+        # A planar circle has no torsion: parallel transport is the rotation about its binormal.
+        nor = _rotate(np.tile(n0, (len(sigma), 1)), self._w[i], theta)
+        return pos, tan, nor
+
+    def piece_index(self, s):
+        """Index of the piece holding arc length ``s`` (pieces are [start, end); the end belongs to the last)."""
+        s = np.asarray(s, dtype=float)
+        return np.clip(np.searchsorted(self.s_end, s, side="right"), 0, len(self.pieces) - 1)
+
+    def frame(self, s):
+        """Position, unit tangent, normal and binormal at arc length ``s``.
+
+        Parameters
+        ----------
+        s : float or (k,) float
+            Arc length, m, clipped to [0, length].
+
+        Returns
+        -------
+        position, tangent, normal, binormal : (3,) or (k, 3) float
+            ``(tangent, normal, binormal)`` is a right-handed orthonormal, rotation-minimising frame.
+        """
+        scalar = np.ndim(s) == 0
+        s = np.clip(np.atleast_1d(np.asarray(s, dtype=float)), 0.0, self.length)
+        idx = self.piece_index(s)
+        pos, tan, nor = np.empty((len(s), 3)), np.empty((len(s), 3)), np.empty((len(s), 3))
+        for i in np.unique(idx):
+            mask = idx == i
+            pos[mask], tan[mask], nor[mask] = self._local(i, s[mask] - self.s_start[i])
+        binormal = np.cross(tan, nor)
+        if scalar:
+            return pos[0], tan[0], nor[0], binormal[0]
+        return pos, tan, nor, binormal
+
+    def position(self, s):
+        """Point at arc length ``s`` (m), shape (3,) or (k, 3)."""
+        return self.frame(s)[0]
+
+    def tangent(self, s):
+        """Unit tangent at arc length ``s`` (m), shape (3,) or (k, 3)."""
+        return self.frame(s)[1]
+
+    def tag_at(self, s):
+        """``"fixed"`` or ``"mobile"`` at arc length ``s`` (str, or array of str)."""
+        tags = np.array([p.tag for p in self.pieces])[self.piece_index(s)]
+        return tags if np.ndim(s) else str(tags)
+
+    def name_at(self, s):
+        """Name of the piece at arc length ``s`` (str, or array of str)."""
+        names = np.array([p.name for p in self.pieces])[self.piece_index(s)]
+        return names if np.ndim(s) else str(names)
+
+    def bounds(self, name):
+        """Arc-length interval (s0, s1), m, covered by the pieces called ``name``."""
+        hits = [i for i, p in enumerate(self.pieces) if p.name == name]
+        if not hits:
+            known = ", ".join(dict.fromkeys(p.name for p in self.pieces))
+            raise ColonsimError(f"no piece called {name!r} in this centerline; use one of: {known}.")
+        return float(self.s_start[hits[0]]), float(self.s_end[hits[-1]])
+
+    @property
+    def min_radius(self):
+        """Smallest bend radius, m (inf for a straight centerline)."""
+        return min((p.radius for p in self.pieces if isinstance(p, Arc)), default=np.inf)
+
+    def check_tube(self, diameter):
+        """Raise ColonsimError if a tube of ``diameter`` (m) around this centerline would cut itself.
+
+        Locally the wall folds at a bend when D/2 >= R. Globally, two cross-sections further apart
+        along s than ``pi D / 2`` (the longest stretch over which a curve with bend radii >= D/2 can
+        stay within D of its start) must be at least D apart; checked on a sampled centerline.
+        """
+        _check_length("tube diameter", diameter, upper=0.12)
+        if 0.5 * diameter >= self.min_radius:
+            raise ColonsimError(
+                f"a {diameter * 1e3:.0f} mm tube does not fit a bend of radius {self.min_radius * 100:.1f} cm "
+                "(the wall folds at D/2 >= R); use a smaller diameter or a larger bend radius."
+            )
+        n = max(2, int(np.ceil(self.length / (0.125 * diameter))) + 1)
+        s = np.linspace(0.0, self.length, n)
+        p = self.position(s)
+        dist = np.linalg.norm(p[:, None, :] - p[None, :, :], axis=-1)
+        far = np.abs(s[:, None] - s[None, :]) > 0.5 * np.pi * diameter
+        clash = far & (dist < diameter * (1.0 - 1e-9))
+        if np.any(clash):
+            i, j = np.argwhere(clash)[0]
+            raise ColonsimError(
+                f"a {diameter * 1e3:.0f} mm tube cuts itself between {self.name_at(s[i])} and "
+                f"{self.name_at(s[j])} (centerlines {dist[i, j] * 100:.1f} cm apart); "
+                "use a smaller diameter or a smaller angle."
+            )
+
+
+def _check_angle(what, value, low, high, why):
+    if not (np.isfinite(value) and low <= value <= high):
+        raise ColonsimError(f"{what} = {value!r} deg is outside {low:g}-{high:g} deg ({why}); choose an angle in range.")
+
+
+def rsj_centerline(rectum_length=0.04, sigmoid_radius=FLEXURE_RADIUS, sigmoid_angle_deg=180.0):
+    """Rectosigmoid junction: a straight fixed rectum, then the mobile sigmoid as one arc.
+
+    Parameters
+    ----------
+    rectum_length : float
+        m (SPEC.md: 4 cm).
+    sigmoid_radius : float
+        m (SPEC.md: 5 cm).
+    sigmoid_angle_deg : float
+        Turning angle of the sigmoid arc, deg (SPEC.md: 180); 0 < angle <= 180, beyond 180 the
+        arc would head back towards the anus.
+    """
+    _check_angle("sigmoid angle", sigmoid_angle_deg, 1e-9, 180.0, "the arc of the junction")
+    return Centerline([Straight(rectum_length, "fixed", "rectum"),
+                       Arc(sigmoid_radius, np.radians(sigmoid_angle_deg), "mobile", "sigmoid")])
+
+
+def rsf_centerline(alpha_deg=0.0, rectum_length=0.04, sigmoid_length=0.20, descending_length=0.10,
+                   flexure_radius=FLEXURE_RADIUS, flexure_angle_deg=90.0, fillet_radius=FILLET_RADIUS):
+    """Rectum to splenic flexure with the sigmoid tilted by ``alpha_deg``.
+
+    Reading of "tilted by alpha" (**assumption**): rectum and descending colon are parallel (the
+    body's long axis, ``+y``); the straight sigmoid between them makes the angle alpha with that
+    axis, leaning to the patient's left (``-n``, i.e. ``+x``) where the descending colon lies, so
+    the descending colon is shifted laterally by about ``L sin(alpha)``. The splenic flexure then
+    turns medially (``+n``) by ``flexure_angle_deg``. alpha = 0 makes rectum, sigmoid and
+    descending colon one straight line. Both kinks get fillets; the largest alpha is set by the
+    fillet fitting on the rectum (``R_f tan(alpha/2) <= rectum``: 77 deg with the defaults).
+
+    Parameters
+    ----------
+    alpha_deg : float
+        Sigmoid tilt, deg, 0 <= alpha < 90 (SPEC.md: 0, 30, 45).
+    rectum_length, sigmoid_length, descending_length : float
+        m (assumption 4 cm as in RSJ; SPEC.md 20 cm; SPEC.md 10 cm).
+    flexure_radius : float
+        m (SPEC.md 5 cm).
+    flexure_angle_deg : float
+        Turn of the splenic flexure, deg (assumption 90: the transverse colon runs across).
+    fillet_radius : float
+        m (assumption 5 cm).
+    """
+    _check_angle("alpha", alpha_deg, 0.0, 89.999, "the sigmoid must still climb from rectum to descending colon")
+    _check_angle("splenic flexure angle", flexure_angle_deg, 1e-9, 180.0, "a flexure turns by at most 180 deg")
+    a = np.radians(alpha_deg)
+    return Centerline([Straight(rectum_length, "fixed", "rectum"),
+                       Kink(-a),
+                       Straight(sigmoid_length, "mobile", "sigmoid"),
+                       Kink(a),
+                       Straight(descending_length, "fixed", "descending"),
+                       Arc(flexure_radius, np.radians(flexure_angle_deg), "fixed", "splenic flexure")],
+                      fillet_radius=fillet_radius)
+
+
+def thf_centerline(beta_deg=0.0, span=0.20, lead_in_length=0.05, ascending_length=0.10,
+                   flexure_radius=FLEXURE_RADIUS, fillet_radius=FILLET_RADIUS, fixed_transverse=False):
+    """Splenic flexure, transverse colon drooping as a V of angle ``beta_deg``, hepatic flexure, ascending colon.
+
+    Reading (**assumptions**): a straight lead-in (the top of the descending colon, ``+y``) gives
+    the scope a straight entry; the splenic flexure turns by 90 + beta; the transverse colon is
+    two straight arms at beta below and above the horizontal, each ``span / (2 cos beta)`` long,
+    so the flexure/transverse junctions are ``span`` apart (the straight-line distance of
+    SPEC.md) and the unrounded V sinks ``span tan(beta) / 2`` (longer and deeper with beta); a
+    fillet rounds the V bottom; the hepatic flexure turns by 90 + beta into the ascending colon
+    (``-y``). beta = 0 makes the transverse colon one straight piece.
+
+    Parameters
+    ----------
+    beta_deg : float
+        Droop angle, deg, 0 <= beta <= 60 (SPEC.md: 0, 30, 45); steeper Vs reach below the
+        lead-in and the ascending colon of the default lengths.
+    span : float
+        Straight-line distance between the ends of the transverse colon, m (SPEC.md 20 cm).
+    lead_in_length, ascending_length : float
+        m (assumption 5 cm, 0 allowed; SPEC.md 10 cm).
+    flexure_radius, fillet_radius : float
+        m (SPEC.md 5 cm; assumption 5 cm).
+    fixed_transverse : bool
+        True for the fixed THF model (no mobile part).
+    """
+    _check_angle("beta", beta_deg, 0.0, 60.0, "a steeper V is not a transverse colon")
+    _check_length("span", span)
+    b = np.radians(beta_deg)
+    tag = "fixed" if fixed_transverse else "mobile"
+    arm = 0.5 * span / np.cos(b)
+    pieces = []
+    if lead_in_length != 0.0:
+        pieces.append(Straight(lead_in_length, "fixed", "descending"))
+    pieces += [Arc(flexure_radius, 0.5 * np.pi + b, "fixed", "splenic flexure"),
+               Straight(arm, tag, "transverse"),
+               Kink(-2.0 * b),
+               Straight(arm, tag, "transverse"),
+               Arc(flexure_radius, 0.5 * np.pi + b, "fixed", "hepatic flexure"),
+               Straight(ascending_length, "fixed", "ascending")]
+    return Centerline(pieces, fillet_radius=fillet_radius)
+
+
+def thf_fixed_centerline(beta_deg=0.0, **kwargs):
+    """Fixed THF: :func:`thf_centerline` with the transverse colon fixed too (SPEC.md 2.1)."""
+    return thf_centerline(beta_deg, fixed_transverse=True, **kwargs)
