@@ -316,25 +316,30 @@ class Centerline:
         along s than ``pi D / 2`` (the longest stretch over which a curve with bend radii >= D/2 can
         stay within D of its start) must be at least D apart; checked on a sampled centerline.
         """
-        _check_length("tube diameter", diameter, upper=0.12)
+        # 1-120 mm: from the thinnest lumen worth simulating to beyond any colon (caecum ~9 cm)
+        if not (np.isfinite(diameter) and 1e-3 <= diameter <= 0.12):
+            raise ColonsimError(f"tube diameter = {diameter!r} m must lie in 1-120 mm; fix the diameter.")
         if 0.5 * diameter >= self.min_radius:
             raise ColonsimError(
                 f"a {diameter * 1e3:.0f} mm tube does not fit a bend of radius {self.min_radius * 100:.1f} cm "
                 "(the wall folds at D/2 >= R); use a smaller diameter or a larger bend radius."
             )
-        n = max(2, int(np.ceil(self.length / (0.125 * diameter))) + 1)
+        # Samples D/8 apart (capped, so a hair-thin tube on a long centerline stays affordable:
+        # the check then only sees clashes deeper than the sample spacing).
+        n = min(5_000, max(2, int(np.ceil(self.length / (0.125 * diameter))) + 1))
         s = np.linspace(0.0, self.length, n)
         p = self.position(s)
-        dist = np.linalg.norm(p[:, None, :] - p[None, :, :], axis=-1)
-        far = np.abs(s[:, None] - s[None, :]) > 0.5 * np.pi * diameter
-        clash = far & (dist < diameter * (1.0 - 1e-9))
-        if np.any(clash):
-            i, j = np.argwhere(clash)[0]
-            raise ColonsimError(
-                f"a {diameter * 1e3:.0f} mm tube cuts itself between {self.name_at(s[i])} and "
-                f"{self.name_at(s[j])} (centerlines {dist[i, j] * 100:.1f} cm apart); "
-                "use a smaller diameter or a smaller angle."
-            )
+        for lo in range(0, n, 1000):  # blocks of rows bound the pairwise-distance memory
+            dist = np.linalg.norm(p[lo:lo + 1000, None, :] - p[None, :, :], axis=-1)
+            far = np.abs(s[lo:lo + 1000, None] - s[None, :]) > 0.5 * np.pi * diameter
+            clash = far & (dist < diameter * (1.0 - 1e-9))
+            if np.any(clash):
+                i, j = np.argwhere(clash)[0]
+                raise ColonsimError(
+                    f"a {diameter * 1e3:.0f} mm tube cuts itself between {self.name_at(s[lo + i])} and "
+                    f"{self.name_at(s[j])} (centerlines {dist[i, j] * 100:.1f} cm apart); "
+                    "use a smaller diameter or a smaller angle."
+                )
 
 
 def _check_angle(what, value, low, high, why):
@@ -385,7 +390,9 @@ def rsf_centerline(alpha_deg=0.0, rectum_length=0.04, sigmoid_length=0.20, desce
     fillet_radius : float
         m (assumption 5 cm).
     """
-    _check_angle("alpha", alpha_deg, 0.0, 89.999, "the sigmoid must still climb from rectum to descending colon")
+    if not (np.isfinite(alpha_deg) and 0.0 <= alpha_deg < 90.0):
+        raise ColonsimError(f"alpha = {alpha_deg!r} deg is outside 0 <= alpha < 90 deg (the sigmoid must climb "
+                            "from the rectum to the descending colon); choose an angle in range.")
     _check_angle("splenic flexure angle", flexure_angle_deg, 1e-9, 180.0, "a flexure turns by at most 180 deg")
     a = np.radians(alpha_deg)
     return Centerline([Straight(rectum_length, "fixed", "rectum"),

@@ -96,7 +96,7 @@ def tube_mesh(centerline: Centerline, diameter, element_size=3e-3) -> TubeMesh:
     ----------
     centerline : Centerline
     diameter : float
-        Diameter of the meshed surface, m (0 < D <= 0.12 m and D/2 below every bend radius).
+        Diameter of the meshed surface, m (1 mm <= D <= 120 mm, D/2 below every bend radius).
     element_size : float
         Target edge length h, m; at least 6 nodes per ring (h <= pi D / 6).
 
