@@ -1,6 +1,7 @@
 """Shared test fixtures."""
 
 import numba
+import numpy as np
 import pytest
 
 
@@ -12,3 +13,22 @@ def serial_kernels():
     numba.set_num_threads(1)
     yield
     numba.set_num_threads(previous)
+
+
+@pytest.fixture
+def energy_gradient():
+    """Central-difference gradient of ``energy(x)`` (a scalar function of positions (n, 3)),
+    step ``h`` in m: the reference the force kernels are checked against (forces = -gradient)."""
+
+    def gradient(energy, x, h=1e-7):
+        g = np.empty_like(x)
+        for i in range(len(x)):
+            for k in range(3):
+                xp = x.copy()
+                xp[i, k] += h
+                xm = x.copy()
+                xm[i, k] -= h
+                g[i, k] = (energy(xp) - energy(xm)) / (2.0 * h)
+        return g
+
+    return gradient
