@@ -347,7 +347,7 @@ def _check_angle(what, value, low, high, why):
         raise ColonsimError(f"{what} = {value!r} deg is outside {low:g}-{high:g} deg ({why}); choose an angle in range.")
 
 
-def rsj_centerline(rectum_length=0.04, sigmoid_radius=FLEXURE_RADIUS, sigmoid_angle_deg=180.0):
+def rsj_centerline(rectum_length=0.04, sigmoid_radius=FLEXURE_RADIUS, sigmoid_angle_deg=180.0, exit_length=0.0):
     """Rectosigmoid junction: a straight fixed rectum, then the mobile sigmoid as one arc.
 
     Parameters
@@ -359,10 +359,17 @@ def rsj_centerline(rectum_length=0.04, sigmoid_radius=FLEXURE_RADIUS, sigmoid_an
     sigmoid_angle_deg : float
         Turning angle of the sigmoid arc, deg (SPEC.md: 180); 0 < angle <= 180, beyond 180 the
         arc would head back towards the anus.
+    exit_length : float
+        m, 0 (SPEC.md's model) or the length of a fixed straight ``"descending"`` piece after the
+        sigmoid (**assumption**: the start of the descending colon), so a scope tip passing the
+        sigmoid's end enters fixed colon instead of leaving the tube.
     """
     _check_angle("sigmoid angle", sigmoid_angle_deg, 1e-9, 180.0, "the arc of the junction")
-    return Centerline([Straight(rectum_length, "fixed", "rectum"),
-                       Arc(sigmoid_radius, np.radians(sigmoid_angle_deg), "mobile", "sigmoid")])
+    pieces = [Straight(rectum_length, "fixed", "rectum"),
+              Arc(sigmoid_radius, np.radians(sigmoid_angle_deg), "mobile", "sigmoid")]
+    if exit_length != 0.0:
+        pieces.append(Straight(exit_length, "fixed", "descending"))
+    return Centerline(pieces)
 
 
 def rsf_centerline(alpha_deg=0.0, rectum_length=0.04, sigmoid_length=0.20, descending_length=0.10,

@@ -35,6 +35,15 @@ def test_rsj_length_is_rectum_plus_half_circle():
     assert t == pytest.approx([0.0, -1.0, 0.0], abs=1e-12)
 
 
+def test_rsj_exit_piece_continues_fixed_after_the_sigmoid():
+    c = rsj_centerline(exit_length=0.05)
+    assert c.length == pytest.approx(0.04 + np.pi * R + 0.05, rel=1e-12)
+    assert c.bounds("sigmoid")[1] == pytest.approx(0.04 + np.pi * R, rel=1e-12)
+    assert c.tag_at(c.length - 0.01) == "fixed" and c.name_at(c.length - 0.01) == "descending"
+    # it carries on from the half circle's end, heading back down
+    assert c.position(c.length) == pytest.approx([-2 * R, -0.01, 0.0], abs=1e-12)
+
+
 @pytest.mark.parametrize("alpha", [0.0, 30.0, 45.0])
 def test_rsf_length_with_fillets(alpha):
     a = np.radians(alpha)
@@ -167,6 +176,7 @@ BAD = [
     (lambda: rsj_centerline(sigmoid_angle_deg=200.0), "sigmoid angle"),
     (lambda: rsj_centerline(sigmoid_angle_deg=0.0), "sigmoid angle"),
     (lambda: rsj_centerline(rectum_length=-0.01), "length of rectum"),
+    (lambda: rsj_centerline(exit_length=-0.01), "length of descending"),
     (lambda: rsf_centerline(sigmoid_length=5.0), "length of sigmoid"),
     (lambda: rsj_centerline(sigmoid_radius=0.0), "radius of sigmoid"),
     (lambda: Centerline([]), "at least one piece"),
