@@ -1,97 +1,154 @@
-"""Colon model geometry (SPEC.md 2.1): centerline lengths, smoothness, tags, mesh quality."""
+"""Colon models as simulation-ready geometry (SPEC.md 2.1): what colon_segments adds to the
+centerlines (tests/test_centerline.py) and the tube mesh (tests/test_colon_geometry.py)."""
 
 import numpy as np
 import pytest
 
 from colonsim.errors import ColonsimError
-from insertion.colon_segments import FILLET_RADIUS, FLEXURE_RADIUS, colon_geometry, rsf_centerline, rsj_centerline, thf_centerline
+from insertion.centerline import FLEXURE_RADIUS, rsf_centerline, rsj_centerline, thf_centerline, thf_fixed_centerline
+from insertion.colon_geometry import tube_mesh
+from insertion.colon_segments import colon_geometry
 
-R, RF = FLEXURE_RADIUS, FILLET_RADIUS
+R = FLEXURE_RADIUS
+D, T, H = 0.036, 2e-3, 3e-3
+
+MODELS = {  # segment, angle, the centerline it must be built on
+    "rsj": ("rsj", 0.0, rsj_centerline),
+    "rsf30": ("rsf", 30.0, lambda: rsf_centerline(30.0)),
+    "thf0": ("thf", 0.0, lambda: thf_centerline(0.0)),
+    "thf30": ("thf", 30.0, lambda: thf_centerline(30.0)),
+    "thf-fixed45": ("thf-fixed", 45.0, lambda: thf_fixed_centerline(45.0)),
+}
+
+
+def _model(name):
+    segment, angle, make = MODELS[name]
+    return colon_geometry(segment, D, angle, H, T), make()
 
 
 def test_rsj_length_is_rectum_plus_half_circle():
-    assert rsj_centerline().length == pytest.approx(0.04 + np.pi * R, rel=1e-12)
+    assert colon_geometry("rsj", 0.023, 0.0, H, T).centerline_length == pytest.approx(0.04 + np.pi * R, rel=1e-12)
 
 
-@pytest.mark.parametrize("alpha", [0.0, 30.0, 45.0])
-def test_rsf_length_with_fillets(alpha):
-    a = np.radians(alpha)
-    # two fillets, each trims R_f tan(a/2) off both neighbours and adds an arc R_f a; flexure 90 deg
-    expected = 0.04 + 0.20 + 0.10 - 4 * RF * np.tan(a / 2) + 2 * RF * a + R * np.pi / 2
-    assert rsf_centerline(alpha).length == pytest.approx(expected, rel=1e-12)
+@pytest.mark.parametrize("name", MODELS)
+def test_centerline_length_and_points_are_the_builders_and_c1(name):
+    g, c = _model(name)
+    assert g.centerline_length == c.length
+    s = np.linspace(0.0, c.length, 1001)
+    assert np.array_equal(g.centerline_points(s), c.position(s))
+    assert g.centerline_points(0.1).shape == (1, 3)
+    # C1 at every junction: one-sided difference quotients agree to the change over h on a bend of R >= 5 cm
+    h = 1e-6
+    for sj in c.s_start[1:]:
+        p = g.centerline_points(np.array([sj - h, sj, sj + h]))
+        assert np.linalg.norm((p[2] - p[1]) - (p[1] - p[0])) / h < 2 * h / R
 
 
-@pytest.mark.parametrize("make", [lambda: rsf_centerline(45.0), lambda: thf_centerline(30.0), lambda: rsj_centerline()])
-def test_centerline_is_c1_at_every_junction(make):
-    c = make()
-    for piece in c.pieces[1:]:
-        s = piece["s0"]
-        p0, t0, _ = c.frame(s - 1e-9)
-        p1, t1, _ = c.frame(s + 1e-9)
-        assert np.linalg.norm(p1 - p0) < 1e-7 and np.linalg.norm(t1 - t0) < 1e-6, piece["name"]
-
-
-def test_rsf_descending_colon_parallel_to_the_rectum_and_sigmoid_tilted():
-    c = rsf_centerline(30.0)
-    s0, s1 = c.ends("sigmoid")
-    assert c.frame(0.5 * (s0 + s1))[1] == pytest.approx([-0.5, np.sqrt(3) / 2, 0.0], abs=1e-12)
-    s0, s1 = c.ends("descending")
-    assert c.frame(0.5 * (s0 + s1))[1] == pytest.approx([0.0, 1.0, 0.0], abs=1e-12)
-
-
-@pytest.mark.parametrize("beta", [0.0, 30.0, 45.0])
-def test_thf_transverse_spans_20_cm_and_droops_with_beta(beta):
-    c = thf_centerline(beta)
-    start = c.frame(c.ends("splenic flexure")[1])[0]
-    end = c.frame(c.ends("hepatic flexure")[0])[0]
-    assert np.linalg.norm(end - start) == pytest.approx(0.20, rel=1e-9)
-    s = np.linspace(c.ends("splenic flexure")[1], c.ends("hepatic flexure")[0], 2001)
-    lowest = min(c.frame(si)[0][1] for si in s)
-    # the sharp V would sink 10 tan(beta) cm; the fillet at its bottom lifts it by R_f (1/cos(beta) - 1)
-    b = np.radians(beta)
-    assert start[1] - lowest == pytest.approx(0.10 * np.tan(b) - RF * (1 / np.cos(b) - 1), abs=1e-6)
-
-
-def test_mesh_tags_normals_and_sizes():
-    g = colon_geometry("rsf", 0.036, 30.0, 3e-3, 2e-3)
-    c = rsf_centerline(30.0)
-    # mobile nodes: exactly the sigmoid's rings
-    s0, s1 = c.ends("sigmoid")
-    assert g.mobile.sum() > 0 and not np.any(g.mobile & g.fixed)
-    assert g.end_ring.sum() == 2 * round(np.pi * 0.038 / 3e-3)
-    # outward normals: away from the centerline at every triangle
-    p = g.nodes[g.triangles]
-    n = np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0])
-    area = 0.5 * np.linalg.norm(n, axis=1)
-    # triangles near-equilateral at 3 mm; compressed to R_in/R = 0.6 on the inside of a bend
-    # and stretched to 1.4 on the outside
-    target = np.sqrt(3) / 4 * (np.pi * 0.038 / round(np.pi * 0.038 / 3e-3)) ** 2
-    assert 0.5 < area.min() / target and area.max() / target < 1.6
-    assert g.straighten_depth == pytest.approx(c.ends("splenic flexure")[0])
+@pytest.mark.parametrize("name", MODELS)
+def test_wall_is_the_tube_mesh_at_the_mid_surface_with_its_tags(name):
+    g, c = _model(name)
+    mesh = tube_mesh(c, D + T, H)  # contact acts half a thickness inside the mid-surface
+    assert np.array_equal(g.nodes, mesh.nodes) and np.array_equal(g.triangles, mesh.triangles)
+    assert np.linalg.norm(g.nodes - c.position(mesh.s), axis=1) == pytest.approx(0.5 * (D + T), abs=1e-12)
+    # every node is exactly one of fixed, mobile, end ring; the end rings are the first and last ring
+    assert np.array_equal(g.fixed.astype(int) + g.mobile + g.end_ring, np.ones(len(g.nodes), int))
+    assert g.end_ring.sum() == 2 * round(np.pi * (D + T) / H)
+    names = np.array([p.name for p in c.pieces])[mesh.piece]
+    mobile_name = {"rsj": "sigmoid", "rsf": "sigmoid"}.get(g.name, "transverse")
+    assert g.mobile.any() == (g.name != "thf-fixed")
+    assert set(names[g.mobile]) <= {mobile_name}
+    assert np.array_equal(g.mobile, (names == mobile_name) & ~g.end_ring & (g.name != "thf-fixed"))
+    assert np.array_equal(g.entry_point, [0.0, 0.0, 0.0]) and np.array_equal(g.entry_axis, [0.0, 1.0, 0.0])
 
 
 def test_mesh_sizes_next_to_the_source():
     """Source: RSJ D23 2064 nodes, RSJ D36 2792, RSF 6632, THF 4086 (its THF did not include our
     5 cm lead-in, the flexures' full arcs and the 10 cm ascending colon)."""
-    sizes = {(s, d): len(colon_geometry(s, d, 0.0, 3e-3, 2e-3).nodes)
+    sizes = {(s, d): len(colon_geometry(s, d, 0.0, H, T).nodes)
              for s, d in (("rsj", 0.023), ("rsj", 0.036), ("rsf", 0.036), ("thf", 0.036))}
     for (seg, d), source in {("rsj", 0.023): 2064, ("rsj", 0.036): 2792, ("rsf", 0.036): 6632}.items():
         assert 0.8 < sizes[seg, d] / source < 1.2, (seg, d, sizes[seg, d])
     assert 1.0 < sizes["thf", 0.036] / 4086 < 2.5
 
 
-@pytest.mark.parametrize("args,message", [(("rsf", 0.036, 75.0), "outside 0-60 deg"),
-                                          (("thf", 0.036, -5.0), "outside 0-60 deg"),
-                                          (("rsj", 0.100, 0.0), "does not fit around a bend"),
-                                          (("sigmoid", 0.036, 0.0), "not a colon model")])
-def test_geometry_errors(args, message):
-    with pytest.raises(ColonsimError, match=message):
-        colon_geometry(*args, 3e-3, 2e-3)
+@pytest.mark.parametrize("alpha", [0.0, 30.0, 45.0])
+def test_rsf_straightens_the_sigmoid_along_its_axis_up_to_the_splenic_flexure(alpha):
+    g = colon_geometry("rsf", D, alpha, H, T)
+    c = rsf_centerline(alpha)
+    assert g.straighten_depth == pytest.approx(c.bounds("splenic flexure")[0])
+    [(direction, nodes)] = g.mobile_axes
+    a = np.radians(alpha)
+    # tilted towards +x, away from the side the splenic flexure turns to (-x)
+    assert direction == pytest.approx([np.sin(a), np.cos(a), 0.0], abs=1e-12)
+    assert c.tangent(c.length) == pytest.approx([-1.0, 0.0, 0.0], abs=1e-12)
+    assert np.array_equal(nodes, np.flatnonzero(g.mobile))
+
+
+@pytest.mark.parametrize("beta", [30.0, 45.0])
+def test_thf_straightens_each_transverse_arm_up_to_the_hepatic_flexure(beta):
+    g = colon_geometry("thf", D, beta, H, T)
+    c = thf_centerline(beta)
+    assert g.straighten_depth == pytest.approx(c.bounds("hepatic flexure")[0])
+    b = np.radians(beta)
+    (d1, n1), (d2, n2) = g.mobile_axes
+    assert d1 == pytest.approx([-np.cos(b), -np.sin(b), 0.0], abs=1e-12)
+    assert d2 == pytest.approx([-np.cos(b), np.sin(b), 0.0], abs=1e-12)
+    assert np.array_equal(np.sort(np.concatenate([n1, n2])), np.flatnonzero(g.mobile))
+    # the V-bottom fillet goes with the first arm
+    fillet = [i for i, p in enumerate(c.pieces) if p.name == "transverse" and hasattr(p, "radius")]
+    s_fillet = 0.5 * (c.s_start[fillet[0]] + c.s_end[fillet[0]])
+    bottom = np.argmin(np.linalg.norm(g.nodes - c.position(s_fillet), axis=1))
+    assert bottom in n1 and bottom not in n2
+
+
+def test_straight_transverse_is_one_axis_and_fixed_thf_has_none():
+    [(direction, nodes)] = colon_geometry("thf", D, 0.0, H, T).mobile_axes
+    assert direction == pytest.approx([-1.0, 0.0, 0.0], abs=1e-12) and nodes.size
+    fixed = colon_geometry("thf-fixed", D, 30.0, H, T)
+    assert fixed.mobile_axes == [] and not fixed.mobile.any()
+    assert fixed.straighten_depth == pytest.approx(thf_fixed_centerline(30.0).bounds("hepatic flexure")[0])
+    rsj = colon_geometry("rsj", D, 0.0, H, T)
+    assert rsj.straighten_depth is None and rsj.mobile_axes == []
+
+
+def test_end_depth_tip_half_a_diameter_past_the_fixed_end():
+    # default: the tube's end less half the meshed (mid-surface) diameter
+    rsj = colon_geometry("rsj", D, 0.0, H, T)
+    assert rsj.end_depth == pytest.approx(0.04 + np.pi * R - 0.5 * (D + T), rel=1e-12)
+    thf = colon_geometry("thf", D, 30.0, H, T)
+    assert thf.end_depth == pytest.approx(thf_centerline(30.0).bounds("hepatic flexure")[1] + 0.5 * D, rel=1e-12)
 
 
 def test_rsj_exit_piece_continues_fixed_and_moves_the_end_of_the_run():
-    g = colon_geometry("rsj", 0.036, 0.0, 3e-3, 2e-3, exit_length=0.05)
-    c = rsj_centerline(exit_length=0.05)
-    assert c.length == pytest.approx(0.04 + np.pi * R + 0.05, rel=1e-12)
-    assert g.end_depth == pytest.approx(0.04 + np.pi * R + 0.018, rel=1e-12)  # tip past the sigmoid's end
-    assert g.fixed.sum() > colon_geometry("rsj", 0.036, 0.0, 3e-3, 2e-3).fixed.sum()
+    g = colon_geometry("rsj", D, 0.0, H, T, exit_length=0.05)
+    assert g.centerline_length == pytest.approx(0.04 + np.pi * R + 0.05, rel=1e-12)
+    assert g.end_depth == pytest.approx(0.04 + np.pi * R + 0.5 * D, rel=1e-12)  # tip past the sigmoid's end
+    assert g.fixed.sum() > colon_geometry("rsj", D, 0.0, H, T).fixed.sum()
+    # sigmoid nodes lie at y >= 4 cm (ring planes on the half circle); the exit piece's below are all held
+    exit_nodes = (g.nodes[:, 0] < -R) & (g.nodes[:, 1] < 0.04 - 1e-9)
+    assert exit_nodes.sum() > 10 * round(np.pi * (D + T) / H) and not g.mobile[exit_nodes].any()
+
+
+def test_straight_sanity_tube_along_x():
+    g = colon_geometry("straight", D, 0.0, H, T)
+    assert np.array_equal(g.entry_axis, [1.0, 0.0, 0.0]) and g.centerline_length == 0.20
+    assert g.nodes[:, 0].min() == 0.0 and g.nodes[:, 0].max() == pytest.approx(0.20)
+    assert g.end_depth == pytest.approx(0.20 - 0.5 * (D + T)) and not g.fixed.any()
+
+
+@pytest.mark.parametrize("args,message", [(("rsf", D, 75.0), "outside 0-60 deg"),
+                                          (("thf", D, -5.0), "outside 0-60 deg"),
+                                          (("thf-fixed", D, 61.0), "outside 0-60 deg"),
+                                          (("rsj", 0.100, 0.0), "does not fit around a bend"),
+                                          (("rsj", 0.097, 0.0), "does not fit around a bend"),
+                                          (("sigmoid", D, 0.0), "not a colon model")])
+def test_geometry_errors(args, message):
+    with pytest.raises(ColonsimError, match=message) as err:
+        colon_geometry(*args, H, T)
+    assert "\n" not in str(err.value)
+
+
+@pytest.mark.parametrize("exit_length", [-0.01, 0.31, float("nan")])
+def test_exit_length_out_of_range(exit_length):
+    with pytest.raises(ColonsimError, match="exit length .* must lie in 0-300 mm"):
+        colon_geometry("rsj", D, 0.0, H, T, exit_length=exit_length)
