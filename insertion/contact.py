@@ -11,7 +11,9 @@ over capsules, so a node near a joint between two segments is counted once):
     friction      f_t = -mu f_n v_t / max(|v_t|, v_reg)
 
 with c the closest point on the segment axis, v_n, v_t the normal and tangential relative
-velocity, m_eff the reduced mass of the wall node (infinite when fixed) and the rod point.
+velocity, m_eff the reduced mass of the wall node (infinite when fixed) and the rod point, and k
+the penalty of a free wall node, or the stiffer one of a held node (whose spring loads only the
+rod, so the wall's light nodes do not limit it).
 Friction is Coulomb, regularised by a slip velocity v_reg: below mu f_n the contact "sticks"
 by creeping at |v_t| = v_reg |F_t| / (mu f_n); v_reg is raised where needed to mu f_n dt / m_eff
 so that the viscous friction stays stable in explicit time stepping. The reaction on the rod is
@@ -133,8 +135,8 @@ def max_displacement(x, x_ref):
 
 
 @numba.njit(cache=True, inline="always")  # a call per node would cost more than its work
-def _contact_one(c, xs, vs, ms, fixed_s, xr, vr, mr, seg, nodes, ptr, cand, radius, offset, k, zeta, mu,
-                 v_slip, dt, fs, rod_seg, rod_t, rod_f, damp_f, fric_f):
+def _contact_one(c, xs, vs, ms, fixed_s, xr, vr, mr, seg, nodes, ptr, cand, radius, offset, k_free, k_held, zeta,
+                 mu, v_slip, dt, fs, rod_seg, rod_t, rod_k, rod_f, damp_f, fric_f):
     """Contact of candidate wall node ``nodes[c]``: (energy, damping power, friction power,
     active 0/1, normal force)."""
     reach = radius + offset
@@ -162,6 +164,7 @@ def _contact_one(c, xs, vs, ms, fixed_s, xr, vr, mr, seg, nodes, ptr, cand, radi
     n2 = (xs[i, 2] - ((1.0 - t) * xr[a, 2] + t * xr[b, 2])) / dist
     mrc = (1.0 - t) * mr[a] + t * mr[b]
     meff = mrc if fixed_s[i] else ms[i] * mrc / (ms[i] + mrc)
+    k = k_held if fixed_s[i] else k_free
     u0 = vs[i, 0] - ((1.0 - t) * vr[a, 0] + t * vr[b, 0])
     u1 = vs[i, 1] - ((1.0 - t) * vr[a, 1] + t * vr[b, 1])
     u2 = vs[i, 2] - ((1.0 - t) * vr[a, 2] + t * vr[b, 2])
@@ -196,6 +199,7 @@ def _contact_one(c, xs, vs, ms, fixed_s, xr, vr, mr, seg, nodes, ptr, cand, radi
     fs[i, 2] += f2
     rod_seg[c] = best_s
     rod_t[c] = t
+    rod_k[c] = k
     rod_f[c, 0] = -f0
     rod_f[c, 1] = -f1
     rod_f[c, 2] = -f2
@@ -203,11 +207,12 @@ def _contact_one(c, xs, vs, ms, fixed_s, xr, vr, mr, seg, nodes, ptr, cand, radi
 
 
 @numba.njit(parallel=True, cache=True)
-def contact_kernel(xs, vs, ms, fixed_s, xr, vr, mr, seg, nodes, ptr, cand, radius, offset, k, zeta, mu,
-                   v_slip, dt, fs, rod_seg, rod_t, rod_f, damp_f, fric_f):
+def contact_kernel(xs, vs, ms, fixed_s, xr, vr, mr, seg, nodes, ptr, cand, radius, offset, k_free, k_held, zeta,
+                   mu, v_slip, dt, fs, rod_seg, rod_t, rod_k, rod_f, damp_f, fric_f):
     """Penalty contact forces on the candidate wall nodes (added into ``fs``) and the reactions on
-    the rod per candidate (``rod_seg`` = -1 if not in contact, ``rod_t``, ``rod_f``); the damping
-    and friction parts of the force on the wall node go to ``damp_f`` and ``fric_f``.
+    the rod per candidate (``rod_seg`` = -1 if not in contact, ``rod_t``, ``rod_k`` the penalty
+    used, ``rod_f``); the damping and friction parts of the force on the wall node go to
+    ``damp_f`` and ``fric_f``. Free wall nodes get the penalty ``k_free``, held ones ``k_held``.
 
     Returns
     -------
@@ -226,7 +231,8 @@ def contact_kernel(xs, vs, ms, fixed_s, xr, vr, mr, seg, nodes, ptr, cand, radiu
     normal = 0.0
     for c in numba.prange(nodes.shape[0]):
         e, pd, pf, a, fn = _contact_one(c, xs, vs, ms, fixed_s, xr, vr, mr, seg, nodes, ptr, cand, radius, offset,
-                                        k, zeta, mu, v_slip, dt, fs, rod_seg, rod_t, rod_f, damp_f, fric_f)
+                                        k_free, k_held, zeta, mu, v_slip, dt, fs, rod_seg, rod_t, rod_k, rod_f,
+                                        damp_f, fric_f)
         energy += e
         p_damp += pd
         p_fric += pf
@@ -236,8 +242,8 @@ def contact_kernel(xs, vs, ms, fixed_s, xr, vr, mr, seg, nodes, ptr, cand, radiu
 
 
 @numba.njit(cache=True)
-def contact_kernel_serial(xs, vs, ms, fixed_s, xr, vr, mr, seg, nodes, ptr, cand, radius, offset, k, zeta,
-                          mu, v_slip, dt, fs, rod_seg, rod_t, rod_f, damp_f, fric_f):
+def contact_kernel_serial(xs, vs, ms, fixed_s, xr, vr, mr, seg, nodes, ptr, cand, radius, offset, k_free,
+                          k_held, zeta, mu, v_slip, dt, fs, rod_seg, rod_t, rod_k, rod_f, damp_f, fric_f):
     """Serial :func:`contact_kernel` for candidate lists too short to pay for threads."""
     energy = 0.0
     p_damp = 0.0
@@ -246,7 +252,8 @@ def contact_kernel_serial(xs, vs, ms, fixed_s, xr, vr, mr, seg, nodes, ptr, cand
     normal = 0.0
     for c in range(nodes.shape[0]):
         e, pd, pf, a, fn = _contact_one(c, xs, vs, ms, fixed_s, xr, vr, mr, seg, nodes, ptr, cand, radius, offset,
-                                        k, zeta, mu, v_slip, dt, fs, rod_seg, rod_t, rod_f, damp_f, fric_f)
+                                        k_free, k_held, zeta, mu, v_slip, dt, fs, rod_seg, rod_t, rod_k, rod_f,
+                                        damp_f, fric_f)
         energy += e
         p_damp += pd
         p_fric += pf
@@ -277,10 +284,10 @@ def dissipation_rates(vs, vr, seg, nodes, rod_seg, rod_t, damp_f, fric_f):
 
 
 @numba.njit(cache=True)
-def rod_reactions(seg, rod_seg, rod_t, rod_f, mr, fr, load):
+def rod_reactions(seg, rod_seg, rod_t, rod_k, rod_f, mr, fr, load):
     """Linear split of the contact reactions onto the rod nodes (serial: contacts are few and
     several of them share rod nodes). Returns the total force on the rod and
-    max over rod nodes of (contact count weight / mass), 1/kg."""
+    max over rod nodes of (penalty stiffness acting on it / mass), 1/s^2."""
     for j in range(load.shape[0]):
         load[j] = 0.0
     t0 = 0.0
@@ -296,8 +303,8 @@ def rod_reactions(seg, rod_seg, rod_t, rod_f, mr, fr, load):
         for k in range(3):
             fr[a, k] += (1.0 - t) * rod_f[c, k]
             fr[b, k] += t * rod_f[c, k]
-        load[a] += 1.0 - t
-        load[b] += t
+        load[a] += (1.0 - t) * rod_k[c]
+        load[b] += t * rod_k[c]
         t0 += rod_f[c, 0]
         t1 += rod_f[c, 1]
         t2 += rod_f[c, 2]
@@ -315,9 +322,16 @@ class RodShellContact:
     rod : insertion.rod.Rod
     shell : insertion.shell.Shell
     stiffness : float or None
-        Penalty stiffness per wall node, N/m. None: chosen so that the lightest wall node on its
-        contact spring oscillates at half the shell's highest frequency (with the default
-        damping the penalty then cuts the stable time step of the wall by about 20 %).
+        Penalty stiffness per free wall node, N/m. None: chosen so that the lightest wall node on
+        its contact spring oscillates at half the shell's highest frequency (with the default
+        damping the penalty then cuts the stable time step of the wall by about 20 %), and kept
+        so as the wall stiffens (:meth:`follow_wall`).
+    held_stiffness : float or None
+        Penalty stiffness per held (fixed) wall node, N/m. A held node does not move, so its
+        spring loads the rod alone and the wall's light nodes need not limit it. None: four held
+        springs on the lightest rod node add what one free spring adds to the lightest wall node
+        (``stiffness * m_rod_min / (4 m_wall_min)``, never less than ``stiffness``). A soft spring
+        on a held node would let a hard-pushed scope sink through the fixed end rings.
     damping_ratio : float
         Fraction zeta of critical damping of each contact spring.
     friction : float
@@ -331,21 +345,27 @@ class RodShellContact:
     """
 
     def __init__(self, rod, shell, stiffness=None, damping_ratio=0.5, friction=0.0, slip_velocity=1e-3,
-                 offset=None, skin=None):
+                 offset=None, skin=None, held_stiffness=None):
         self.rod = rod
         self.shell = shell
         self.offset = 0.5 * shell.thickness if offset is None else float(offset)
         self.skin = 0.5 * rod.radius if skin is None else float(skin)
+        self._free_follows_wall = stiffness is None
+        self._held_follows_wall = held_stiffness is None
         if stiffness is None:
             omega = 2.0 / shell.critical_time_step(np.ascontiguousarray(shell.x0))
-            stiffness = 0.25 * float(shell.mass.min()) * omega**2
-        checks = (("stiffness", stiffness, stiffness > 0.0), ("damping_ratio", damping_ratio, damping_ratio >= 0.0),
+            stiffness = self._free_penalty(omega**2)
+        if held_stiffness is None:
+            held_stiffness = self._held_penalty(stiffness)
+        checks = (("stiffness", stiffness, stiffness > 0.0), ("held_stiffness", held_stiffness, held_stiffness > 0.0),
+                  ("damping_ratio", damping_ratio, damping_ratio >= 0.0),
                   ("friction", friction, friction >= 0.0), ("slip_velocity", slip_velocity, slip_velocity > 0.0),
                   ("offset", self.offset, self.offset >= 0.0), ("skin", self.skin, self.skin > 0.0))
         for label, value, ok in checks:
             if not (np.isfinite(value) and ok):
                 raise ColonsimError(f"contact {label} = {value!r} is out of range; fix it.")
         self.stiffness = float(stiffness)
+        self.held_stiffness = float(held_stiffness)
         self.damping_ratio = float(damping_ratio)
         self.friction = float(friction)
         self.slip_velocity = float(slip_velocity)
@@ -370,6 +390,25 @@ class RodShellContact:
         self.force_on_rod = np.zeros(3)
         self._p_damp = 0.0
         self._p_fric = 0.0
+
+    def _free_penalty(self, wall_omega2):
+        return 0.25 * float(self.shell.mass.min()) * wall_omega2
+
+    def _held_penalty(self, free):
+        return free * max(1.0, float(self.rod.mass.min()) / (4.0 * float(self.shell.mass.min())))
+
+    def follow_wall(self, body_omega2):
+        """Penalties left to their defaults follow the wall's current highest squared frequency
+        (``body_omega2[shell name]``, rad^2/s^2; the solver passes it at every time-step update).
+
+        The Mooney-Rivlin wall stiffens several-fold as it stretches; a penalty set once at the
+        unstretched state would let the scope sink through a stretched wall. Following the wall
+        keeps the penalty's share of the stable time step what it was at the start.
+        """
+        if self._free_follows_wall:
+            self.stiffness = self._free_penalty(body_omega2[self.shell.name])
+        if self._held_follows_wall:
+            self.held_stiffness = self._held_penalty(self.stiffness)
 
     # -- broad phase -------------------------------------------------------------------------
 
@@ -397,6 +436,7 @@ class RodShellContact:
         self._nodes, self._ptr, self._cand = nodes, ptr, cand
         self._rod_seg = np.full(len(nodes), -1, dtype=np.int64)
         self._rod_t = np.zeros(len(nodes))
+        self._rod_k = np.zeros(len(nodes))
         self._rod_f = np.zeros((len(nodes), 3))
         self._damp_f = np.zeros((len(nodes), 3))
         self._fric_f = np.zeros((len(nodes), 3))
@@ -415,11 +455,12 @@ class RodShellContact:
         kernel = contact_kernel if len(self._nodes) >= self.parallel_min_candidates else contact_kernel_serial
         energy, p_damp, p_fric, n_active, normal = kernel(
             s.x, s.v, self.shell.mass, s.fixed, r.x, r.v, self.rod.mass, self.rod.segments, self._nodes, self._ptr,
-            self._cand, self.rod.radius, self.offset, self.stiffness, self.damping_ratio, self.friction,
-            self.slip_velocity, dt, s.f_con, self._rod_seg, self._rod_t, self._rod_f, self._damp_f, self._fric_f,
+            self._cand, self.rod.radius, self.offset, self.stiffness, self.held_stiffness, self.damping_ratio,
+            self.friction, self.slip_velocity, dt, s.f_con, self._rod_seg, self._rod_t, self._rod_k, self._rod_f,
+            self._damp_f, self._fric_f,
         )
-        f0, f1, f2, weight = rod_reactions(self.rod.segments, self._rod_seg, self._rod_t, self._rod_f, self.rod.mass,
-                                           r.f_con, self._load)
+        f0, f1, f2, weight = rod_reactions(self.rod.segments, self._rod_seg, self._rod_t, self._rod_k, self._rod_f,
+                                           self.rod.mass, r.f_con, self._load)
         self.energy = energy
         self._p_damp = p_damp
         self._p_fric = p_fric
@@ -456,14 +497,16 @@ class RodShellContact:
     def frequency_squared(self):
         """Squared frequency the penalty springs add to each body (Gershgorin rows), rad^2/s^2.
 
-        Wall: one spring per node, k / m. Rod: k times the largest contact weight per unit mass
-        of the last evaluation, doubled for contacts appearing before the next update, and at
-        least that of four full contacts on the lightest rod node. Both are divided by the
-        square of :meth:`damping_reduction` (a damped spring counts as a stiffer undamped one).
+        Wall: one free spring per node, k / m. Rod: the largest penalty stiffness per unit mass
+        on a rod node of the last evaluation, doubled for contacts appearing before the next
+        update, and at least that of four full held-node contacts on the lightest rod node. Both
+        are divided by the square of :meth:`damping_reduction` (a damped spring counts as a
+        stiffer undamped one).
         """
-        k = self.stiffness / self.damping_reduction() ** 2
-        rod_w = max(2.0 * self._rod_weight, 4.0 / float(self.rod.mass.min()))
-        return {self.shell.name: k / float(self.shell.mass.min()), self.rod.name: k * rod_w}
+        reduction = self.damping_reduction() ** 2
+        rod_w2 = max(2.0 * self._rod_weight, 4.0 * self.held_stiffness / float(self.rod.mass.min()))
+        return {self.shell.name: self.stiffness / float(self.shell.mass.min()) / reduction,
+                self.rod.name: rod_w2 / reduction}
 
     def damping_reduction(self):
         """Factor sqrt(1 + zeta^2) - zeta on the stable step of a damped spring (damping force from

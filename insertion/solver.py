@@ -511,10 +511,11 @@ class ExplicitSolver:
 
         Per body omega^2 = (2 / dt_body)^2 plus the contact penalty's contribution on that body
         (Gershgorin: the stiffness rows add; a contact reports its damped springs as equivalent
-        undamped ones).
+        undamped ones). Contacts first adapt their penalty to the bodies' current frequencies.
         """
         omega2 = {b.name: (2.0 / b.critical_time_step(self.state[b.name].x)) ** 2 for b in self.bodies}
         for c in self.contacts:
+            c.follow_wall(omega2)
             for name, w2 in c.frequency_squared().items():
                 omega2[name] += w2
         return 2.0 / math.sqrt(max(omega2.values()))

@@ -20,7 +20,7 @@ def slide(tangential):
     wall, rod, contact, under = rod_on_sheet(friction=MU)
     share = rod.mass / rod.mass.sum()
     normal = NodalLoad(rod, np.arange(rod.n_nodes), np.column_stack((0 * share, 0 * share, -N * share)))
-    omega = math.sqrt(len(under) * contact.stiffness / rod.mass.sum())
+    omega = math.sqrt(len(under) * contact.held_stiffness / rod.mass.sum())
     t1 = 30.0 / omega  # contact springs critically damped: settled after 30 time constants
     pull = NodalLoad(rod, np.arange(rod.n_nodes), np.column_stack((tangential * share, 0 * share, 0 * share)),
                      start=t1)
