@@ -268,7 +268,9 @@ def run_insertions(cases, out: Path, vtu=False, snapshot_every=0.02, show=True):
               f"max {s['max_deformation_cm']:.2f} cm ({pts}); peak contact {s['peak_contact_force_N']:.2f} N, "
               f"peak push {s['peak_push_force_N']:.2f} N; quasi-static {'holds' if s['quasi_static']['holds'] else 'does NOT hold'} "
               f"(KE/IE < 10 %: colon {100 * s['quasi_static']['fraction_below_10pct']['colon']:.0f} %, "
-              f"scope {100 * s['quasi_static']['fraction_below_10pct']['scope']:.0f} % of samples); "
+              f"scope {100 * s['quasi_static']['fraction_below_10pct']['scope']:.0f} % of samples, "
+              f"{100 * s['quasi_static']['scope_without_imposed_sliding']['fraction_below_10pct']:.0f} % without its "
+              f"imposed sliding); "
               f"{s['steps']} steps in {s['wall_time_s']:.1f} s -> {folder}/")
     table = comparison_table(results)
     write_csv(out / "comparison.csv", table)

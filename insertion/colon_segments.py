@@ -52,14 +52,13 @@ class ColonGeometry:
     centerline_points: object  # callable s -> (n, 3)
     straighten_depth: float | None = None
     mobile_axes: list = field(default_factory=list)
-    end_depth: float | None = None  # pushed depth at which the run ends (tip past the fixed end)
+    # arc length of the plane (normal to the centerline) the tip must cross to have "passed the
+    # fixed end" (SPEC.md 2.4); default: the far end ring
+    end_depth: float | None = None
 
     def __post_init__(self):
         if self.end_depth is None:
-            self.end_depth = self.centerline_length - 0.5 * self._diameter()
-
-    def _diameter(self):
-        return 2.0 * float(np.linalg.norm(self.nodes[0] - self.entry_point))
+            self.end_depth = self.centerline_length
 
     def summary(self) -> dict:
         return {"segment": self.name, "wall_nodes": int(len(self.nodes)), "wall_triangles": int(len(self.triangles)),

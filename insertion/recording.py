@@ -2,9 +2,11 @@
 
 Columns (SI): time_s, depth_m (pushed distance), deformation_m (largest nodal displacement of
 the mobile colon part), max_stretch (largest in-plane principal stretch of the wall), tip_displacement_m,
-tip_arc_m (tip position along the centerline), contact_force_N (sum of normal contact forces),
+tip_arc_m (tip position along the centerline, the closest centerline point), tip_past_end_m
+(signed distance of the tip past the end plane of the run: >= 0 once it has passed the fixed end), contact_force_N (sum of normal contact forces),
 push_force_N (drive reaction along the sheath axis), contact_nodes, kinetic/internal energy
-of each body (J), contact_energy_J, dt_s, step.
+of each body (J), kinetic_scope_sliding_J (the scope's kinetic energy relative to sliding along
+itself at the push speed, :func:`insertion.outcomes.sliding_kinetic_energy`), contact_energy_J, dt_s, step.
 """
 
 from __future__ import annotations
@@ -12,7 +14,7 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from insertion.outcomes import principal_stretches
+from insertion.outcomes import principal_stretches, sliding_kinetic_energy
 
 
 class InsertionRecorder:
@@ -31,6 +33,11 @@ class InsertionRecorder:
         s = np.linspace(0.0, g.centerline_length, max(200, int(g.centerline_length / 1e-3)))
         self._arc = s
         self._arc_points = np.asarray(g.centerline_points(s))
+        # the plane the tip must cross to have "passed the fixed end" (SPEC.md 2.4)
+        ends = np.clip([model.tip_end - 1e-4, model.tip_end, model.tip_end + 1e-4], 0.0, g.centerline_length)
+        p = np.asarray(g.centerline_points(ends))
+        self._end_point = p[1]
+        self._end_axis = (p[2] - p[0]) / np.linalg.norm(p[2] - p[0])
 
     def __call__(self, solver):
         m = self.model
@@ -50,12 +57,14 @@ class InsertionRecorder:
             "max_stretch": float(principal_stretches(colon.x, m.shell.triangles, m.shell.dm_inv).max()),
             "tip_displacement_m": float(np.linalg.norm(tip - self._tip0)),
             "tip_arc_m": float(self._arc[np.argmin(((self._arc_points - tip) ** 2).sum(axis=1))]),
+            "tip_past_end_m": float(np.dot(tip - self._end_point, self._end_axis)),
             "contact_force_N": float(m.contact.normal_force),
             "contact_nodes": int(m.contact.n_active),
             "push_force_N": float(np.dot(m.drive.reaction, m.entry_axis)),
             "kinetic_colon_J": colon.kinetic,
             "internal_colon_J": colon.internal,
             "kinetic_scope_J": scope.kinetic,
+            "kinetic_scope_sliding_J": sliding_kinetic_energy(scope.x, scope.v, m.rod.mass, m.push.speed(solver.time)),
             "internal_scope_J": scope.internal,
             "contact_energy_J": float(m.contact.energy),
             "phase": m.push.phase_at(solver.time).name,

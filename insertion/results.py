@@ -24,9 +24,11 @@ def user_units(ts: pd.DataFrame) -> pd.DataFrame:
     out = pd.DataFrame({"time_s": ts["time_s"], "phase": ts["phase"], "depth_cm": ts["depth_m"] * 100,
                         "deformation_cm": ts["deformation_m"] * 100, "max_wall_stretch": ts["max_stretch"],
                         "tip_displacement_cm": ts["tip_displacement_m"] * 100, "tip_arc_cm": ts["tip_arc_m"] * 100,
+                        "tip_past_end_cm": ts["tip_past_end_m"] * 100,
                         "contact_force_N": ts["contact_force_N"], "push_force_N": ts["push_force_N"],
                         "contact_nodes": ts["contact_nodes"]})
-    for col in ("kinetic_colon_J", "internal_colon_J", "kinetic_scope_J", "internal_scope_J", "contact_energy_J",
+    for col in ("kinetic_colon_J", "internal_colon_J", "kinetic_scope_J", "kinetic_scope_sliding_J", "internal_scope_J",
+                "contact_energy_J",
                 "dt_s", "step"):
         out[col] = ts[col]
     return out
@@ -43,7 +45,9 @@ def comparison_table(results) -> pd.DataFrame:
                            "peak_contact_force_N": r.summary["peak_contact_force_N"],
                            "peak_push_force_N": r.summary["peak_push_force_N"],
                            "max_wall_stretch": r.summary["max_wall_stretch"],
-                           "quasi_static": r.summary["quasi_static"]["holds"], "wall_time_s": r.summary["wall_time_s"]}
+                           "quasi_static": r.summary["quasi_static"]["holds"],
+                           "quasi_static_without_imposed_sliding": r.summary["quasi_static"]["holds_without_imposed_sliding"],
+                           "ended_by": r.summary["ended_by"], "wall_time_s": r.summary["wall_time_s"]}
                           for r in results])
 
 

@@ -111,10 +111,10 @@ def test_straight_transverse_is_one_axis_and_fixed_thf_has_none():
     assert rsj.straighten_depth is None and rsj.mobile_axes == []
 
 
-def test_end_depth_tip_half_a_diameter_past_the_fixed_end():
-    # default: the tube's end less half the meshed (mid-surface) diameter
+def test_end_depth_is_the_plane_the_tip_must_cross():
+    # default: the far end ring (the tip has passed the fixed end when it crosses it)
     rsj = colon_geometry("rsj", D, 0.0, H, T)
-    assert rsj.end_depth == pytest.approx(0.04 + np.pi * R - 0.5 * (D + T), rel=1e-12)
+    assert rsj.end_depth == pytest.approx(0.04 + np.pi * R, rel=1e-12) == rsj.centerline_length
     thf = colon_geometry("thf", D, 30.0, H, T)
     assert thf.end_depth == pytest.approx(thf_centerline(30.0).bounds("hepatic flexure")[1] + 0.5 * D, rel=1e-12)
 
@@ -133,7 +133,7 @@ def test_straight_sanity_tube_along_x():
     g = colon_geometry("straight", D, 0.0, H, T)
     assert np.array_equal(g.entry_axis, [1.0, 0.0, 0.0]) and g.centerline_length == 0.20
     assert g.nodes[:, 0].min() == 0.0 and g.nodes[:, 0].max() == pytest.approx(0.20)
-    assert g.end_depth == pytest.approx(0.20 - 0.5 * (D + T)) and not g.fixed.any()
+    assert g.end_depth == pytest.approx(0.20) and not g.fixed.any()
 
 
 @pytest.mark.parametrize("args,message", [(("rsf", D, 75.0), "outside 0-60 deg"),

@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from insertion.outcomes import characteristic_points, principal_stretches, quasi_static_fraction
+from insertion.outcomes import characteristic_points, principal_stretches, quasi_static_fraction, sliding_kinetic_energy
 
 
 def rsj_like(noise=0.0, seed=0):
@@ -55,3 +55,15 @@ def test_principal_stretch_of_a_stretched_and_rotated_triangle():
     rotation = np.array([[1, 0, 0], [0, c, -s], [0, s, c]])
     x = nodes @ stretch.T @ rotation.T
     assert principal_stretches(x, tri, dm_inv)[0] == pytest.approx(1.3, rel=1e-12)
+
+
+def test_sliding_kinetic_energy_removes_only_the_tank_tread_motion():
+    # nodes on a quarter circle moving along the tangent at the push speed: nothing left
+    phi = np.linspace(0.0, np.pi / 2, 40)
+    x = np.column_stack([np.cos(phi), np.sin(phi), np.zeros_like(phi)])
+    tangent = np.column_stack([-np.sin(phi), np.cos(phi), np.zeros_like(phi)])
+    mass = np.full(40, 0.01)
+    assert sliding_kinetic_energy(x, 0.6 * tangent, mass, 0.6) == pytest.approx(0.0, abs=1e-5)  # one-sided ends
+    # a sideways velocity w on top of the sliding: 1/2 m w^2 exactly
+    w = np.array([0.0, 0.0, 0.2])
+    assert sliding_kinetic_energy(x, 0.6 * tangent + w, mass, 0.6) == pytest.approx(0.5 * 0.4 * 0.04, rel=1e-3)
