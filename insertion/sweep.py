@@ -59,7 +59,7 @@ def _inputs(case) -> dict:
         if value is None:  # a column keeps one type: "" for absent strings, NaN for absent numbers
             value = "" if "str" in str(f.type) else math.nan
         row[f.name] = value
-    row["scope_diameter_mm"] = colonoscope(case.scope).diameter * 1e3
+    row["scope_diameter_mm"] = round(colonoscope(case.scope).diameter * 1e3, 6)  # 11.3, not 11.299999999999999
     return row
 
 
@@ -99,7 +99,8 @@ class SweepStore:
         self.rows = {}
         self._lock = None
 
-    def _load(self):
+    def load(self):
+        """Read the rows already in the table (no lock needed: the table is replaced atomically)."""
         if self.table_path.is_file():
             try:
                 table = pd.read_parquet(self.table_path)
@@ -122,8 +123,10 @@ class SweepStore:
             os.write(fd, str(os.getpid()).encode())
             os.close(fd)
             self._lock = lock
+            for stale in self.folder.glob(f".{TABLE}.*"):  # temporary copy of a sweep killed mid-write
+                stale.unlink(missing_ok=True)
             try:
-                self._load()
+                self.load()
             except BaseException:
                 self.__exit__()
                 raise
@@ -260,7 +263,7 @@ def dask_outcomes(cases, address, runner=None, log=print):
         token = uuid.uuid4().hex[:8]
         futures = {client.submit(execute, case, runner, key=f"insertion-{case.key()}-{token}"): case for case in cases}
         try:
-            for future in as_completed(futures):
+            for future in as_completed(futures, loop=client.loop):
                 case = futures[future]
                 try:
                     outcome = future.result()
