@@ -22,6 +22,12 @@ Format (every key of ``[fixed]``, ``[[grid]]`` and ``[lhs]`` is a field of
     scope = ["utc", "sdc"]
     angle_deg = [0, 30, 45]
 
+or, for a space-filling design crossed with a grid (2 x 20 runs)::
+
+    [[grid]]
+    segment = "rsj"
+    friction = [0, 0.1]
+
     [lhs]                        # Latin hypercube over continuous ranges [low, high]
     samples = 20
     diameter_mm = [20, 40]

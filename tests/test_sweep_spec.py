@@ -2,6 +2,8 @@
 
 import dataclasses
 import json
+import re
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -152,3 +154,11 @@ def test_cli_dry_run_lists_the_cases(tmp_path, capsys):
     out = capsys.readouterr().out
     assert "39 runs, 0 already in" in out and "thf-fixed" in out
     assert not (tmp_path / "t").exists()
+
+
+def test_the_sweep_files_of_the_documentation_parse():
+    """Every TOML block of docs/sweeps.md is a valid sweep (no run)."""
+    text = (Path(__file__).resolve().parents[1] / "docs" / "sweeps.md").read_text()
+    blocks = re.findall(r"```toml\n(.*?)```", text, flags=re.S)
+    sizes = [len(parse_sweep(block).cases) for block in blocks]
+    assert sizes == [4 * 2 * 3 + 2 * 2 * 3, 2 * 20]
