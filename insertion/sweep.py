@@ -37,7 +37,7 @@ from colonsim.errors import ColonsimError
 from colonsim.files import atomic_path, write_json
 from insertion.scenario import InsertionCase, InsertionResult
 from insertion.scopes import colonoscope
-from insertion.sweep_worker import execute, prepare_worker
+from insertion.sweep_worker import execute, start_worker
 
 TABLE = "results.parquet"
 LOCK = ".sweep.lock"
@@ -191,13 +191,6 @@ def _failed(case, message) -> dict:
             "finished_at": datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds")}
 
 
-def _start_worker():
-    try:
-        prepare_worker()
-    except Exception:  # noqa: BLE001 - the first run calls it again and records the error
-        pass
-
-
 def local_outcomes(cases, workers=2, runner=None):
     """Run ``cases`` in a local process pool; yield ``(case, outcome)`` as runs finish.
 
@@ -208,7 +201,7 @@ def local_outcomes(cases, workers=2, runner=None):
     pending = list(cases)
     context = multiprocessing.get_context("spawn")
     while pending:
-        pool = ProcessPoolExecutor(max_workers=workers, mp_context=context, initializer=_start_worker)
+        pool = ProcessPoolExecutor(max_workers=workers, mp_context=context, initializer=start_worker)
         in_flight = {}
         clean = False
         try:

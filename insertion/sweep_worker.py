@@ -54,6 +54,14 @@ def prepare_worker():
         _PREPARED = True
 
 
+def start_worker():
+    """Initializer of a local pool process (must not raise: the pool would break)."""
+    try:
+        prepare_worker()
+    except (Exception, KeyboardInterrupt):  # the first run calls it again and records the error; Ctrl-C: quietly
+        pass
+
+
 def default_runner(case):
     from insertion.scenario import run_insertion
 
