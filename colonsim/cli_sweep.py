@@ -50,7 +50,7 @@ def cmd_sweep(args):
     where = f"Dask cluster {args.scheduler}" if args.scheduler else f"{workers} local process{'es' if workers > 1 else ''}"
     if args.dry_run:
         store = SweepStore(out)
-        store._load()
+        store.load()
         done = store.finished(args.retry_failed)
         print(describe_cases(spec.cases))
         todo = sum(c.key() not in done for c in spec.cases)
