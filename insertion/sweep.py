@@ -64,19 +64,17 @@ def _inputs(case) -> dict:
 
 
 def _outputs(summary) -> dict:
-    if summary is None:
-        return {name: (False if name == "quasi_static" else math.nan) for name in OUTPUTS}
-    points = summary.get("points_cm", {})
-
+    """The scalar outputs of a summary (None for a failed run): NaN when undefined, cm and N."""
     def number(value):
-        return math.nan if value is None else float(value)
+        return float(value) if isinstance(value, (int, float)) else math.nan
 
-    out = {name: number(summary.get(name)) for name in OUTPUTS if name not in ("quasi_static",)
-           and not name.startswith("point_")}
+    summary = summary or {}
+    points = summary.get("points_cm") or {}
+    out = {name: number(summary.get(name)) for name in OUTPUTS}
     for p in "ABC":
         out[f"point_{p}_cm"] = number((points.get(p) or {}).get("deformation_cm"))
-    out["quasi_static"] = bool(summary.get("quasi_static", {}).get("holds", False))
-    return {name: out[name] for name in OUTPUTS}
+    out["quasi_static"] = bool((summary.get("quasi_static") or {}).get("holds", False))
+    return out
 
 
 def result_row(case, outcome, timeseries_path="") -> dict:
