@@ -1,0 +1,72 @@
+"""``colonsim sweep``: run insertions over scopes and anatomies, locally or on a Dask cluster."""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+from colonsim.errors import ColonsimError
+
+
+def _cores() -> int:
+    try:
+        return len(os.sched_getaffinity(0))
+    except AttributeError:  # pragma: no cover - not Linux
+        return os.cpu_count() or 1
+
+
+def add_parser(sub):
+    """Add the ``sweep`` subcommand to the subparsers ``sub`` of :func:`colonsim.cli.build_parser`."""
+    p = sub.add_parser("sweep", help="run insertions over scopes, anatomies and friction (resumable)",
+                       description="Run the insertion model over a grid and/or Latin hypercube of inputs "
+                                   "(SPEC.md 3), described in a TOML file (format: docs/sweeps.md) or a preset. "
+                                   "Writes results.parquet (one row per run) and runs/<key>/ per run. Rerunning "
+                                   "into the same --out skips the runs already finished.")
+    p.add_argument("spec", nargs="?", type=Path, help="sweep TOML file")
+    p.add_argument("--preset", help="thesis (the source's 39 insertions) or smoke (3 fast runs)")
+    p.add_argument("--workers", type=int, default=None,
+                   help=f"local worker processes, one Numba thread each (default: the cores, {_cores()} here)")
+    p.add_argument("--scheduler", metavar="ADDR",
+                   help="run on a Dask distributed cluster, e.g. tcp://HOST:8786 (workers: dask worker ADDR --nthreads 1)")
+    p.add_argument("--out", type=Path, help="output folder (default colonsim_results/sweep_NAME)")
+    p.add_argument("--retry-failed", action="store_true", help="run again the cases recorded as failed")
+    p.add_argument("--dry-run", action="store_true", help="list the cases and which are done, run nothing")
+    p.add_argument("--no-progress", action="store_true", help="no progress bar")
+    p.set_defaults(func=cmd_sweep)
+    return p
+
+
+def cmd_sweep(args):
+    from insertion.sweep import SweepStore, describe_cases, run_sweep
+    from insertion.sweep_spec import load_sweep
+
+    if args.scheduler is not None and args.workers is not None:
+        raise ColonsimError("--workers is for local runs; a Dask cluster (--scheduler) has its own workers")
+    workers = _cores() if args.workers is None else args.workers
+    if workers < 1:
+        raise ColonsimError(f"--workers {workers}; give at least 1")
+    spec = load_sweep(args.spec, args.preset)
+    out = args.out or Path("colonsim_results") / f"sweep_{spec.name}"
+    where = f"Dask cluster {args.scheduler}" if args.scheduler else f"{workers} local process{'es' if workers > 1 else ''}"
+    if args.dry_run:
+        store = SweepStore(out)
+        store.load()
+        done = store.finished(args.retry_failed)
+        print(describe_cases(spec.cases))
+        todo = sum(c.key() not in done for c in spec.cases)
+        print(f"sweep {spec.name}: {len(spec.cases)} runs, {len(spec.cases) - todo} already in {out}/, "
+              f"{todo} to run on {where}")
+        return
+    print(f"sweep {spec.name}: {len(spec.cases)} runs on {where} -> {out}/", flush=True)
+    report = run_sweep(spec.cases, out, workers=workers, scheduler=args.scheduler, retry_failed=args.retry_failed,
+                       spec=spec, progress=not args.no_progress)
+    rate = "" if report.ran == 0 else f" ({report.runs_per_hour:.0f} runs/hour)"
+    print(f"{report.skipped} already finished (skipped), {report.ran} run in {report.wall_time_s:.1f} s{rate}: "
+          f"{report.ok} ok, {report.failed} failed")
+    failed = report.table[report.table["status"] == "failed"]
+    for _, row in failed.head(10).iterrows():
+        print(f"  failed {row['key']} ({row['segment']} {row['scope']} D {row['diameter_mm']:g} mm): {row['error']}")
+    if len(failed):
+        more = f" (+{len(failed) - 10} more)" if len(failed) > 10 else ""
+        print(f"{len(failed)} failed run(s){more} are recorded; rerun with --retry-failed to try them again")
+    print(f"results: {out / 'results.parquet'} ({len(report.table)} runs of this sweep), time series in {out / 'runs'}/")

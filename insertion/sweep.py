@@ -1,0 +1,361 @@
+"""Run a sweep of insertions: a resumable results store and two ways to run the cases.
+
+Output folder::
+
+    results.parquet     one row per run (columns: :data:`IDENTITY`, every InsertionCase field,
+                        ``scope_diameter_mm``, :data:`OUTPUTS`); rewritten atomically after each run
+    sweep.json          the sweep that was last run here (name, seed, keys, TOML text)
+    runs/<key>/         timeseries.csv, summary.json, insertion.png of each successful run
+
+A run is identified by :meth:`InsertionCase.key` (a hash of every input). Rerunning a sweep into
+the same folder skips the keys already in the table, so a killed sweep loses at most the runs
+that were in flight; failed runs are recorded with their error (rerun them with
+``retry_failed=True``) and never stop the others.
+
+Runs go to a local process pool (:func:`local_outcomes`) or to an existing Dask distributed
+cluster (:func:`dask_outcomes`); both yield outcomes as runs finish, and only this process
+writes files, so Dask workers need the package but no shared file system (material files
+named in the cases must exist on the workers, though).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import multiprocessing
+import os
+import time
+import uuid
+from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
+from concurrent.futures.process import BrokenProcessPool
+from dataclasses import dataclass
+from pathlib import Path
+
+import pandas as pd
+
+from colonsim.errors import ColonsimError
+from colonsim.files import atomic_path, write_json
+from insertion.scenario import InsertionCase, InsertionResult
+from insertion.scopes import colonoscope
+from insertion.sweep_worker import execute, start_worker
+
+TABLE = "results.parquet"
+LOCK = ".sweep.lock"
+DIED = "worker process died during this run (killed or out of memory)"
+IDENTITY = ("key", "status", "error", "wall_time_s", "timeseries_path", "finished_at")
+OUTPUTS = ("final_deformation_cm", "max_deformation_cm", "point_A_cm", "point_B_cm", "point_C_cm",
+           "peak_contact_force_N", "peak_push_force_N", "max_wall_stretch", "quasi_static", "simulated_time_s")
+
+
+def input_columns() -> list:
+    """Every InsertionCase field (from the dataclass) and the derived scope diameter."""
+    return [f.name for f in dataclasses.fields(InsertionCase)] + ["scope_diameter_mm"]
+
+
+def _inputs(case) -> dict:
+    row = {}
+    for f in dataclasses.fields(InsertionCase):
+        value = getattr(case, f.name)
+        if value is None:  # a column keeps one type: "" for absent strings, NaN for absent numbers
+            value = "" if "str" in str(f.type) else math.nan
+        row[f.name] = value
+    row["scope_diameter_mm"] = round(colonoscope(case.scope).diameter * 1e3, 6)  # 11.3, not 11.299999999999999
+    return row
+
+
+def _outputs(summary) -> dict:
+    """The scalar outputs of a summary (None for a failed run): NaN when undefined, cm and N."""
+    def number(value):
+        return float(value) if isinstance(value, (int, float)) else math.nan
+
+    summary = summary or {}
+    points = summary.get("points_cm") or {}
+    out = {name: number(summary.get(name)) for name in OUTPUTS}
+    for p in "ABC":
+        out[f"point_{p}_cm"] = number((points.get(p) or {}).get("deformation_cm"))
+    out["quasi_static"] = bool((summary.get("quasi_static") or {}).get("holds", False))
+    return out
+
+
+def result_row(case, outcome, timeseries_path="") -> dict:
+    """The table row of one run (``outcome`` from :func:`insertion.sweep_worker.execute`)."""
+    ok = outcome["status"] == "ok"
+    return {"key": case.key(), "status": outcome["status"], "error": outcome.get("error", ""),
+            "wall_time_s": float(outcome["wall_time_s"]), "timeseries_path": timeseries_path if ok else "",
+            "finished_at": outcome["finished_at"], **_inputs(case), **_outputs(outcome.get("summary") if ok else None)}
+
+
+class SweepStore:
+    """The results of a sweep folder: read at start, one row added (atomically) per finished run.
+
+    Holds a lock file while open so that two sweeps never write the same table.
+    """
+
+    def __init__(self, folder):
+        self.folder = Path(folder)
+        self.table_path = self.folder / TABLE
+        self.rows = {}
+        self._lock = None
+
+    def load(self):
+        """Read the rows already in the table (no lock needed: the table is replaced atomically)."""
+        if self.table_path.is_file():
+            try:
+                table = pd.read_parquet(self.table_path)
+            except Exception as exc:
+                raise ColonsimError(f"cannot read {self.table_path} ({exc}); move it away to start the sweep afresh") from None
+            self.rows = {row["key"]: row for row in table.to_dict("records")}
+
+    def __enter__(self):
+        self.folder.mkdir(parents=True, exist_ok=True)
+        lock = self.folder / LOCK
+        for _ in range(2):
+            try:
+                fd = os.open(lock, os.O_CREAT | os.O_EXCL | os.O_WRONLY)
+            except FileExistsError:
+                if _alive(lock):
+                    raise ColonsimError(f"another sweep (pid {lock.read_text().strip()}) is writing to {self.folder}; "
+                                        "wait for it or use another --out") from None
+                lock.unlink(missing_ok=True)  # left by a killed sweep
+                continue
+            os.write(fd, str(os.getpid()).encode())
+            os.close(fd)
+            self._lock = lock
+            for stale in self.folder.glob(f".{TABLE}.*"):  # temporary copy of a sweep killed mid-write
+                stale.unlink(missing_ok=True)
+            try:
+                self.load()
+            except BaseException:
+                self.__exit__()
+                raise
+            return self
+        raise ColonsimError(f"cannot take the lock {lock}; remove it if no sweep is running")
+
+    def __exit__(self, *exc):
+        if self._lock is not None:
+            self._lock.unlink(missing_ok=True)
+            self._lock = None
+
+    def finished(self, retry_failed=False) -> set:
+        """Keys that need no new run: ok runs, and failed ones unless ``retry_failed``."""
+        return {k for k, r in self.rows.items() if r["status"] == "ok" or (r["status"] == "failed" and not retry_failed)}
+
+    def record(self, case, outcome) -> dict:
+        """Write the run folder (ok runs), then the table with the run's row; return the row."""
+        path = ""
+        if outcome["status"] == "ok":
+            from insertion.results import write_insertion
+
+            folder = Path("runs") / case.key()
+            result = InsertionResult(case, outcome["timeseries"], outcome["summary"], snapshots=[], model=None)
+            written = write_insertion(result, self.folder / folder)
+            path = (folder / written["timeseries"].name).as_posix()
+        row = result_row(case, outcome, path)
+        self.rows[row["key"]] = row
+        self.write()
+        return row
+
+    def table(self) -> pd.DataFrame:
+        """All rows, contract columns first (older rows may add columns of removed inputs)."""
+        frame = pd.DataFrame(list(self.rows.values()))
+        first = [*IDENTITY, *input_columns(), *OUTPUTS]
+        if frame.empty:
+            return pd.DataFrame(columns=first)
+        for col in first:
+            if col not in frame:
+                frame[col] = math.nan  # a field added to InsertionCase after older rows were written
+        frame = frame[first + [c for c in frame.columns if c not in first]]
+        frame["quasi_static"] = frame["quasi_static"].fillna(False).astype(bool)
+        return frame.reset_index(drop=True)
+
+    def write(self):
+        with atomic_path(self.table_path) as tmp:
+            self.table().to_parquet(tmp, index=False)
+
+
+def _alive(lock: Path) -> bool:
+    try:
+        pid = int(lock.read_text().strip())
+        os.kill(pid, 0)
+    except (ValueError, OSError):
+        return False
+    return pid != os.getpid()
+
+
+def _failed(case, message) -> dict:
+    import datetime
+
+    return {"key": case.key(), "status": "failed", "error": message, "wall_time_s": math.nan,
+            "finished_at": datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds")}
+
+
+def local_outcomes(cases, workers=2, runner=None):
+    """Run ``cases`` in a local process pool; yield ``(case, outcome)`` as runs finish.
+
+    At most ``workers`` runs are in flight, so a worker that dies (killed, out of memory) costs
+    only the runs it had: they are reported failed and a fresh pool takes the rest. Workers are
+    spawned (not forked: the parent may hold Numba threads) with one Numba thread each.
+    """
+    pending = list(cases)
+    context = multiprocessing.get_context("spawn")
+    while pending:
+        pool = ProcessPoolExecutor(max_workers=workers, mp_context=context, initializer=start_worker)
+        in_flight = {}
+        clean = False
+        try:
+            while pending or in_flight:
+                while pending and len(in_flight) < workers:
+                    case = pending.pop(0)
+                    in_flight[pool.submit(execute, case, runner)] = case
+                done, _ = wait(in_flight, return_when=FIRST_COMPLETED)
+                broken = False
+                for future in done:
+                    case = in_flight.pop(future)
+                    try:
+                        outcome = future.result()
+                    except BrokenProcessPool:
+                        broken = True
+                        outcome = _failed(case, DIED)
+                    except Exception as exc:  # e.g. an outcome that could not be sent back
+                        outcome = _failed(case, f"{type(exc).__name__}: {' '.join(str(exc).split())}")
+                    yield case, outcome
+                if broken:
+                    for future, case in in_flight.items():
+                        yield case, _failed(case, DIED)
+                    in_flight.clear()
+                    break
+            clean = True
+        finally:
+            pool.shutdown(wait=clean, cancel_futures=True)
+
+
+def dask_outcomes(cases, address, runner=None, log=print):
+    """Send ``cases`` to the Dask distributed scheduler at ``address``; yield ``(case, outcome)``.
+
+    Workers should run one task at a time (``dask worker ADDR --nthreads 1``, one worker per
+    core): runs within a worker process are serialized anyway. Each worker loads the kernels
+    once, at its first run (outside the timed part), which also covers workers that join late.
+    """
+    from distributed import Client, as_completed
+
+    try:
+        client = Client(address, timeout="15s", set_as_default=False)
+    except (OSError, TimeoutError) as exc:
+        raise ColonsimError(f"cannot reach the Dask scheduler at {address} ({exc}); start one with "
+                            f"`dask scheduler` and workers with `dask worker {address} --nthreads 1`") from None
+    with client:
+        workers = client.scheduler_info().get("workers", {})
+        if not workers:
+            log(f"no Dask worker at {address} yet; the runs wait for one (`dask worker {address} --nthreads 1`)")
+        threads = sorted({w.get("nthreads", 1) for w in workers.values()})
+        if threads and threads[-1] > 1:
+            log(f"note: Dask workers with {threads[-1]} threads run one insertion at a time; start them with "
+                "--nthreads 1 and one worker per core for full use of the machine")
+        token = uuid.uuid4().hex[:8]
+        futures = {client.submit(execute, case, runner, key=f"insertion-{case.key()}-{token}"): case for case in cases}
+        try:
+            for future in as_completed(futures, loop=client.loop):
+                case = futures[future]
+                try:
+                    outcome = future.result()
+                except Exception as exc:  # the task itself failed: worker lost (KilledWorker), cancelled, ...
+                    outcome = _failed(case, f"{type(exc).__name__}: {' '.join(str(exc).split())}")
+                future.release()
+                yield case, outcome
+        finally:
+            client.cancel(list(futures))
+
+
+@dataclass
+class SweepReport:
+    """What a call to :func:`run_sweep` did."""
+
+    folder: Path
+    total: int
+    skipped: int
+    ran: int
+    ok: int
+    failed: int
+    wall_time_s: float
+    table: pd.DataFrame
+
+    @property
+    def runs_per_hour(self) -> float:
+        return 3600.0 * self.ran / self.wall_time_s if self.ran and self.wall_time_s > 0 else math.nan
+
+
+def run_sweep(cases, out, workers=2, scheduler=None, runner=None, retry_failed=False, spec=None,
+              progress=True, log=print) -> SweepReport:
+    """Run every case of a sweep not yet finished in ``out``; record each run as it finishes.
+
+    Parameters
+    ----------
+    cases : list of InsertionCase
+        Validated cases (:func:`insertion.sweep_spec.load_sweep`).
+    out : path
+        The sweep folder (created; reused to resume).
+    workers : int
+        Local worker processes (ignored with ``scheduler``).
+    scheduler : str or None
+        Address of a Dask distributed scheduler, e.g. ``tcp://10.0.0.5:8786``.
+    runner : callable(case) -> result, or None
+        The simulation (default :func:`insertion.scenario.run_insertion`); must be importable
+        by the workers.
+    retry_failed : bool
+        Run again the cases recorded as failed.
+    spec : SweepSpec or None
+        Written to ``sweep.json`` for the record.
+    """
+    if workers < 1:
+        raise ColonsimError(f"workers = {workers}; give at least 1 worker process")
+    for case in cases:
+        case.validate()
+    out = Path(out)
+    t0 = time.perf_counter()
+    with SweepStore(out) as store:
+        if spec is not None:
+            write_json(out / "sweep.json", spec.document())
+        done = store.finished(retry_failed)
+        todo = [c for c in cases if c.key() not in done]
+        skipped = len(cases) - len(todo)
+        ok = failed = 0
+        if todo:
+            outcomes = (dask_outcomes(todo, scheduler, runner, log) if scheduler
+                        else local_outcomes(todo, min(workers, len(todo)), runner))
+            from tqdm import tqdm
+
+            bar = tqdm(total=len(todo), unit="run", disable=None if progress else True, dynamic_ncols=True,
+                       leave=False, mininterval=0.5)
+            try:
+                for case, outcome in outcomes:
+                    row = store.record(case, outcome)
+                    ok += row["status"] == "ok"
+                    failed += row["status"] == "failed"
+                    bar.set_postfix_str(f"ok {ok}, failed {failed}")
+                    bar.update(1)
+            finally:
+                bar.close()
+                outcomes.close()
+        table = store.table()
+    wanted = {c.key() for c in cases}
+    table = table[table["key"].isin(wanted)].reset_index(drop=True)
+    return SweepReport(out, len(cases), skipped, ok + failed, ok, failed, time.perf_counter() - t0, table)
+
+
+def read_results(folder) -> pd.DataFrame:
+    """The results table of a sweep folder."""
+    path = Path(folder) / TABLE
+    if not path.is_file():
+        raise ColonsimError(f"no {TABLE} in {folder}; run `colonsim sweep ... --out {folder}` first")
+    return pd.read_parquet(path)
+
+
+def describe_cases(cases) -> str:
+    """The cases as an aligned text table (inputs that vary, plus the key)."""
+    frame = pd.DataFrame([{**c.to_dict(), "key": c.key()} for c in cases])
+    varying = [c for c in frame.columns if c != "key" and frame[c].astype(str).nunique() > 1]
+    return frame[["key", *varying]].to_string(index=False)
+
+
+__all__ = ["SweepStore", "SweepReport", "run_sweep", "local_outcomes", "dask_outcomes", "read_results",
+           "result_row", "describe_cases", "IDENTITY", "OUTPUTS", "TABLE"]

@@ -1,0 +1,337 @@
+"""What a sweep runs: a TOML description (or a preset) expanded into validated insertion cases.
+
+Format (every key of ``[fixed]``, ``[[grid]]`` and ``[lhs]`` is a field of
+:class:`insertion.scenario.InsertionCase`, in its user units, or ``scope_diameter_mm``)::
+
+    [sweep]
+    name = "rsj-scopes"          # names the default output folder
+    seed = 1                     # seed of the Latin hypercube (default 0)
+    description = "..."          # optional, free text
+
+    [fixed]                      # the same value in every case
+    element_size_mm = 4.0
+
+    [[grid]]                     # every combination of the lists (a scalar = a one-value list)
+    segment = "rsj"
+    scope = ["utc", "pdc", "sdc"]
+    diameter_mm = [23, 36]
+    friction = [0, 0.05, 0.1]
+
+    [[grid]]                     # more blocks: the sweep is the union of the blocks
+    segment = ["rsf", "thf"]
+    scope = ["utc", "sdc"]
+    angle_deg = [0, 30, 45]
+
+or, for a space-filling design crossed with a grid (2 x 20 runs)::
+
+    [[grid]]
+    segment = "rsj"
+    friction = [0, 0.1]
+
+    [lhs]                        # Latin hypercube over continuous ranges [low, high]
+    samples = 20
+    diameter_mm = [20, 40]
+    scope_diameter_mm = [9, 13]
+
+- ``scope`` takes ``utc``, ``pdc``, ``sdc`` or a diameter in mm; ``scope_diameter_mm`` (numbers)
+  is the same axis given as diameters. Give one of the two.
+- ``material`` takes a material JSON path (relative paths are read from the TOML file's folder);
+  ``""`` means the source's parameters.
+- With both ``[[grid]]`` and ``[lhs]``, every grid case is crossed with every hypercube sample.
+  A key may appear in only one of ``[fixed]``, the grid blocks and ``[lhs]``.
+- Values are rounded to 3 decimals in the hypercube so that tables stay readable; the seed makes
+  the sample (and so every run's key) reproducible.
+- Cases that come out identical (same :meth:`InsertionCase.key`) run once.
+
+Every case is validated before anything runs; errors are one line naming the key and the fix.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import difflib
+import itertools
+import sys
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from colonsim.errors import ColonsimError
+from insertion.scenario import InsertionCase
+
+if sys.version_info >= (3, 11):
+    import tomllib
+else:  # pragma: no cover
+    import tomli as tomllib
+
+SCOPE_DIAMETER = "scope_diameter_mm"
+SECTIONS = ("sweep", "fixed", "grid", "lhs")
+SWEEP_KEYS = ("name", "seed", "description")
+LHS_DECIMALS = 3
+
+PRESETS = {
+    # SPEC.md 2.5 / the source's Chapter V: RSJ D23/D36 x 3 scopes x mu 0/0.05/0.1 (18 runs);
+    # RSF alpha and THF beta 0/30/45 x 3 scopes at mu 0 (18); fixed THF x 3 scopes (3).
+    "thesis": """
+[sweep]
+name = "thesis"
+description = "Every insertion of the source's Chapter V (SPEC.md 2.5): RSJ, RSF, THF and fixed THF"
+
+[[grid]]
+segment = "rsj"
+scope = ["utc", "pdc", "sdc"]
+diameter_mm = [23, 36]
+friction = [0, 0.05, 0.1]
+
+[[grid]]
+segment = ["rsf", "thf"]
+scope = ["utc", "pdc", "sdc"]
+angle_deg = [0, 30, 45]
+
+[[grid]]
+segment = "thf-fixed"
+scope = ["utc", "pdc", "sdc"]
+""",
+    # A few runs of a few seconds each on a coarse wall mesh: for tests and for checking a setup.
+    "smoke": """
+[sweep]
+name = "smoke"
+description = "Three fast runs on a coarse 7.5 mm wall mesh (tests, setup checks); not physics"
+
+[fixed]
+element_size_mm = 7.5
+
+[[grid]]
+segment = "straight"
+scope = "pdc"
+
+[[grid]]
+segment = "rsj"
+scope = ["utc", "sdc"]
+friction = [0.05]
+""",
+}
+
+
+@dataclass
+class SweepSpec:
+    """A parsed sweep: its name, seed, source text and the cases it expands to."""
+
+    name: str
+    seed: int
+    description: str
+    cases: list = field(default_factory=list)
+    source: str = ""
+
+    def document(self) -> dict:
+        """A JSON-able description (written next to the results)."""
+        return {"name": self.name, "seed": self.seed, "description": self.description, "runs": len(self.cases),
+                "keys": [c.key() for c in self.cases], "toml": self.source}
+
+
+def case_fields() -> dict:
+    """The fields of :class:`InsertionCase` by name (taken from the dataclass, never hard-coded)."""
+    return {f.name: f for f in dataclasses.fields(InsertionCase)}
+
+
+def _unknown(key, where, known):
+    close = difflib.get_close_matches(key, known, n=1)
+    hint = f"did you mean {close[0]!r}? " if close else ""
+    raise ColonsimError(f"unknown key {key!r} in [{where}]; {hint}use one of: {', '.join(known)}")
+
+
+def _coerce(name, value, where, base: Path | None):
+    """``value`` in the type of field ``name`` (floats as floats, so that keys do not depend on 23 vs 23.0)."""
+    if name == SCOPE_DIAMETER:
+        name, value = "scope", _number(SCOPE_DIAMETER, value, where)
+    f = case_fields()[name]
+    default = f.default
+    if name == "scope":
+        if isinstance(value, bool) or not isinstance(value, (str, int, float)):
+            raise ColonsimError(f"{where}: scope = {value!r}; give utc, pdc, sdc or a diameter in mm")
+        return "scope", (f"{value:g}" if isinstance(value, (int, float)) else value.strip().lower())
+    if name == "material":
+        if not isinstance(value, str):
+            raise ColonsimError(f"{where}: material = {value!r}; give the path of a material JSON or \"\" for the default")
+        if not value:
+            return name, None
+        path = Path(value).expanduser()
+        if base is not None and not path.is_absolute():
+            path = base / path
+        return name, str(path.resolve())
+    if isinstance(default, bool):
+        if not isinstance(value, bool):
+            raise ColonsimError(f"{where}: {name} = {value!r}; give true or false")
+        return name, value
+    if isinstance(default, float):
+        return name, _number(name, value, where)
+    if isinstance(default, int):
+        if isinstance(value, bool) or not isinstance(value, int):
+            raise ColonsimError(f"{where}: {name} = {value!r}; give an integer")
+        return name, value
+    if isinstance(default, str):
+        if not isinstance(value, str):
+            raise ColonsimError(f"{where}: {name} = {value!r}; give a string")
+        return name, value.strip().lower() if name == "segment" else value
+    return name, value
+
+
+def _number(name, value, where):
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        raise ColonsimError(f"{where}: {name} = {value!r}; give a number")
+    return float(value)
+
+
+def _axis_keys(table, where):
+    known = [*case_fields(), SCOPE_DIAMETER]
+    for key in table:
+        if key not in known:
+            _unknown(key, where, known)
+    if "scope" in table and SCOPE_DIAMETER in table:
+        raise ColonsimError(f"[{where}] gives both scope and {SCOPE_DIAMETER}; they are the same axis, keep one")
+
+
+def _grid_cases(block, where, base):
+    _axis_keys(block, where)
+    axes = []
+    for key, values in block.items():
+        values = values if isinstance(values, list) else [values]
+        if not values:
+            raise ColonsimError(f"[{where}] {key} is an empty list; give at least one value or remove the key")
+        axes.append([_coerce(key, v, f"[{where}]", base) for v in values])
+    return [dict(combo) for combo in itertools.product(*axes)]
+
+
+def latin_hypercube(n: int, d: int, seed: int) -> np.ndarray:
+    """``n`` points in [0, 1)^d, one per row and column stratum (scipy's LHS, seeded)."""
+    from scipy.stats import qmc
+
+    return qmc.LatinHypercube(d=d, seed=seed).random(n)
+
+
+def _lhs_cases(table, seed, base):
+    table = dict(table)
+    samples = table.pop("samples", None)
+    if isinstance(samples, bool) or not isinstance(samples, int) or samples < 1:
+        raise ColonsimError(f"[lhs] samples = {samples!r}; give the number of hypercube points, e.g. samples = 20")
+    _axis_keys(table, "lhs")
+    if not table:
+        raise ColonsimError("[lhs] has no ranges; add e.g. diameter_mm = [20, 40]")
+    ranges = []
+    for key, bounds in table.items():
+        if (not isinstance(bounds, list) or len(bounds) != 2
+                or any(isinstance(b, bool) or not isinstance(b, (int, float)) for b in bounds) or not bounds[0] < bounds[1]):
+            raise ColonsimError(f"[lhs] {key} = {bounds!r}; give a range [low, high] of numbers with low < high")
+        if key != SCOPE_DIAMETER and not isinstance(case_fields()[key].default, float):
+            raise ColonsimError(f"[lhs] {key} is not a continuous input; put it in a [[grid]] block instead")
+        ranges.append((key, float(bounds[0]), float(bounds[1])))
+    unit = latin_hypercube(samples, len(ranges), seed)
+    cases = []
+    for row in unit:
+        values = (round(lo + u * (hi - lo), LHS_DECIMALS) for (_, lo, hi), u in zip(ranges, row))
+        cases.append(dict(_coerce(key, v, "[lhs]", base) for (key, _, _), v in zip(ranges, values)))
+    return cases
+
+
+def parse_sweep(text: str, base: Path | None = None, origin: str = "sweep") -> SweepSpec:
+    """Parse a sweep TOML document into a :class:`SweepSpec` with validated cases.
+
+    Parameters
+    ----------
+    text : str
+        The TOML document (format in the module docstring).
+    base : Path or None
+        Folder that relative material paths are read from.
+    origin : str
+        Where the text came from (file or preset), for messages.
+    """
+    try:
+        doc = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise ColonsimError(f"{origin} is not valid TOML: {exc}") from None
+    for section in doc:
+        if section not in SECTIONS:
+            _unknown(section, "top level", list(SECTIONS))
+    head = doc.get("sweep", {})
+    if not isinstance(head, dict):
+        raise ColonsimError(f"{origin}: [sweep] must be a table (name, seed, description)")
+    for key in head:
+        if key not in SWEEP_KEYS:
+            _unknown(key, "sweep", list(SWEEP_KEYS))
+    name = head.get("name", Path(origin).stem if origin.endswith(".toml") else "sweep")
+    seed = head.get("seed", 0)
+    if not isinstance(name, str) or not name.strip() or any(c in name for c in "/\\"):
+        raise ColonsimError(f"[sweep] name = {name!r}; give a short name without slashes (it names the output folder)")
+    if isinstance(seed, bool) or not isinstance(seed, int) or seed < 0:
+        raise ColonsimError(f"[sweep] seed = {seed!r}; give a non-negative integer")
+
+    fixed = doc.get("fixed", {})
+    if not isinstance(fixed, dict):
+        raise ColonsimError(f"{origin}: [fixed] must be a table of key = value")
+    _axis_keys(fixed, "fixed")
+    for key, value in fixed.items():
+        if isinstance(value, list):
+            raise ColonsimError(f"[fixed] {key} = {value!r} is a list; put varying values in a [[grid]] block")
+    fixed = dict(_coerce(k, v, "[fixed]", base) for k, v in fixed.items())
+
+    grid = doc.get("grid", [])
+    blocks = [grid] if isinstance(grid, dict) else grid
+    if not isinstance(blocks, list) or not all(isinstance(b, dict) for b in blocks):
+        raise ColonsimError(f"{origin}: [grid] / [[grid]] must be tables of key = [values]")
+    grid_cases = []
+    grid_keys = set()
+    for i, block in enumerate(blocks, 1):
+        where = "grid" if len(blocks) == 1 else f"grid block {i}"
+        grid_cases += _grid_cases(block, where, base)
+        grid_keys |= {("scope" if k == SCOPE_DIAMETER else k) for k in block}
+    lhs = doc.get("lhs")
+    lhs_cases = _lhs_cases(lhs, seed, base) if lhs is not None else []
+    lhs_keys = {("scope" if k == SCOPE_DIAMETER else k) for k in (lhs or {}) if k != "samples"}
+    fixed_keys = set(fixed)
+    for a, b, ka, kb in (("fixed", "grid", fixed_keys, grid_keys), ("fixed", "lhs", fixed_keys, lhs_keys),
+                         ("grid", "lhs", grid_keys, lhs_keys)):
+        if ka & kb:
+            raise ColonsimError(f"{', '.join(sorted(ka & kb))} appears in both [{a}] and [{b}]; give each input in one place")
+
+    if lhs is None:
+        combos = grid_cases or [{}]
+    else:
+        combos = [{**g, **s} for g in (grid_cases or [{}]) for s in lhs_cases]
+    if not grid_cases and lhs is None and not fixed:
+        raise ColonsimError(f"{origin} describes no runs; add a [[grid]] block, an [lhs] table or a preset")
+    cases, seen = [], set()
+    for values in combos:
+        case = InsertionCase(**{**fixed, **values})
+        try:
+            case.validate()
+        except ColonsimError as exc:
+            shown = ", ".join(f"{k}={v}" for k, v in values.items())
+            raise ColonsimError(f"case ({shown or 'defaults'}): {exc}") from None
+        if case.key() not in seen:
+            seen.add(case.key())
+            cases.append(case)
+    _check_materials(cases)
+    return SweepSpec(name=name.strip(), seed=seed, description=str(head.get("description", "")), cases=cases,
+                     source=text)
+
+
+def _check_materials(cases):
+    from insertion.material import load_material
+
+    for path in sorted({c.material for c in cases if c.material}):
+        load_material(path)
+
+
+def load_sweep(path=None, preset: str | None = None) -> SweepSpec:
+    """A sweep from a TOML file or a preset name (exactly one of the two)."""
+    if (path is None) == (preset is None):
+        raise ColonsimError("give a sweep TOML file or --preset NAME (one of the two)")
+    if preset is not None:
+        if preset not in PRESETS:
+            raise ColonsimError(f"unknown preset {preset!r}; use one of {', '.join(PRESETS)}")
+        return parse_sweep(PRESETS[preset], origin=f"preset {preset}")
+    path = Path(path)
+    if not path.is_file():
+        raise ColonsimError(f"sweep file {path} not found; give the path of a TOML file or use --preset")
+    return parse_sweep(path.read_text(encoding="utf-8"), base=path.parent, origin=str(path))

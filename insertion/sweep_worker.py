@@ -1,0 +1,99 @@
+"""The worker side of a sweep: one Numba thread per process, kernels warmed once, one run per call.
+
+This module imports nothing heavy at the top so that a fresh worker process can still set
+``NUMBA_NUM_THREADS=1`` before Numba is imported: worker processes share the cores, and two
+processes with two Numba threads each on two cores run 30-40x slower. ``numba.set_num_threads``
+is thread-local, so :func:`execute` sets it again in the thread that runs the case (Dask runs
+tasks in a thread pool).
+"""
+
+from __future__ import annotations
+
+import datetime
+import os
+import sys
+import threading
+import time
+
+_PREPARED = False
+# Runs of one process go one at a time: the Numba threading layers are not all safe for
+# kernels launched from several threads at once (Dask workers started with --nthreads > 1).
+_RUN_LOCK = threading.Lock()
+
+
+def _one_thread():
+    if "numba" not in sys.modules:
+        os.environ["NUMBA_NUM_THREADS"] = "1"
+    import numba
+
+    numba.set_num_threads(1)
+
+
+def warm_up_case():
+    """A tiny insertion (coarse straight tube, fast push) that touches every kernel once."""
+    from insertion.scenario import InsertionCase
+
+    return InsertionCase(segment="straight", scope="pdc", element_size_mm=12.0, scope_spacing_mm=20.0,
+                         push_speed=5.0, ramp_s=0.01, record_interval_s=0.01)
+
+
+def prepare_worker():
+    """Process initializer: 1 Numba thread, kernels loaded (compiled, or read from the cache) once.
+
+    Idempotent; :func:`execute` calls it too, so workers that join a Dask cluster later are
+    prepared by their first run (outside its timed part).
+    """
+    global _PREPARED
+    _one_thread()
+    with _RUN_LOCK:
+        if _PREPARED:
+            return
+        from insertion.scenario import run_insertion
+
+        run_insertion(warm_up_case())
+        _PREPARED = True
+
+
+def start_worker():
+    """Initializer of a local pool process (must not raise: the pool would break)."""
+    try:
+        prepare_worker()
+    except (Exception, KeyboardInterrupt):  # the first run calls it again and records the error; Ctrl-C: quietly
+        pass
+
+
+def default_runner(case):
+    from insertion.scenario import run_insertion
+
+    return run_insertion(case)
+
+
+def execute(case, runner=None) -> dict:
+    """Run one case and return its outcome (never raises for a failed simulation).
+
+    Parameters
+    ----------
+    case : InsertionCase
+    runner : callable(case) -> result with ``.summary`` and ``.timeseries``, or None
+        The simulation (default :func:`insertion.scenario.run_insertion`); tests inject failures here.
+
+    Returns
+    -------
+    dict
+        ``key``, ``status`` ("ok" | "failed"), ``error``, ``wall_time_s``, ``finished_at``, and for
+        ok runs ``summary`` and ``timeseries`` (SI DataFrame), which the client writes.
+    """
+    prepare_worker()
+    _one_thread()
+    runner = runner or default_runner
+    with _RUN_LOCK:
+        t0 = time.perf_counter()
+        try:
+            result = runner(case)
+            outcome = {"status": "ok", "error": "", "summary": result.summary, "timeseries": result.timeseries}
+        except Exception as exc:  # a failed run is a result too; the sweep goes on
+            message = " ".join(str(exc).split()) or "(no message)"
+            outcome = {"status": "failed", "error": f"{type(exc).__name__}: {message}"}
+        wall = time.perf_counter() - t0
+    return {"key": case.key(), "wall_time_s": wall,
+            "finished_at": datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds"), **outcome}

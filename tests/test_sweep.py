@@ -1,0 +1,135 @@
+"""Sweeps that run: a real Dask LocalCluster on loopback, resume after a killed sweep, failed runs.
+
+The smoke preset (3 runs of a few seconds on a coarse wall mesh) keeps this file near 40 s on 2 cores.
+"""
+
+import dataclasses
+import math
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pandas as pd
+import pytest
+
+from insertion.scenario import InsertionCase, run_insertion
+from insertion.sweep import DIED, IDENTITY, OUTPUTS, TABLE, SweepStore, result_row, run_sweep
+from insertion.sweep_spec import load_sweep
+
+ROOT = Path(__file__).resolve().parents[1]
+SMOKE = load_sweep(preset="smoke").cases
+# The columns the surrogate reads (its contract with the sweep).
+CONTRACT = ["key", "status", "error", "wall_time_s", "timeseries_path", "finished_at", "segment", "scope",
+            "diameter_mm", "angle_deg", "friction", "wall_thickness_mm", "material", "scope_diameter_mm",
+            "final_deformation_cm", "max_deformation_cm", "point_A_cm", "point_B_cm", "point_C_cm",
+            "peak_contact_force_N", "peak_push_force_N", "max_wall_stretch", "quasi_static", "simulated_time_s"]
+
+
+def failing_runner(case):
+    """Runs the real simulation, except: straight -> an error; RSJ UTC -> the worker process dies."""
+    if case.segment == "straight":
+        raise RuntimeError("injected failure\nsecond line")
+    if case.scope == "utc":
+        os._exit(3)
+    return run_insertion(case)
+
+
+def check_ok_rows(folder, table):
+    ok = table[table["status"] == "ok"]
+    for _, row in ok.iterrows():
+        ts = pd.read_csv(folder / row["timeseries_path"])
+        assert len(ts) > 10 and (folder / "runs" / row["key"] / "summary.json").is_file()
+        assert row["error"] == "" and row["wall_time_s"] > 0 and math.isfinite(row["final_deformation_cm"])
+    rsj = ok[ok["segment"] == "rsj"]
+    assert (rsj["max_deformation_cm"] > 0).all() and (rsj["peak_contact_force_N"] > 0).all()
+
+
+def test_smoke_sweep_on_a_dask_local_cluster(tmp_path):
+    distributed = pytest.importorskip("distributed")
+    out = tmp_path / "smoke"
+    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, host="127.0.0.1",
+                                  dashboard_address=None) as cluster:
+        report = run_sweep(SMOKE, out, scheduler=cluster.scheduler_address, progress=False)
+        assert (report.ran, report.ok, report.failed, report.skipped) == (3, 3, 0, 0)
+        # every worker ran with one Numba thread (set by the sweep, not by the cluster's environment)
+        with distributed.Client(cluster) as client:
+            threads = client.run(lambda: __import__("numba").config.NUMBA_NUM_THREADS)
+        assert set(threads.values()) == {1}
+    table = pd.read_parquet(out / TABLE)
+    assert len(table) == 3 and set(table["key"]) == {c.key() for c in SMOKE}
+    assert set(CONTRACT) <= set(table.columns)
+    assert list(table.columns) == [*IDENTITY, *(f.name for f in dataclasses.fields(InsertionCase)),
+                                   "scope_diameter_mm", *OUTPUTS]
+    assert table["quasi_static"].dtype == bool and sorted(table["scope_diameter_mm"]) == [9.2, 11.3, 12.8]
+    check_ok_rows(out, table)
+    # nothing left to do: the same sweep is skipped entirely, without a cluster
+    again = run_sweep(SMOKE, out, progress=False)
+    assert (again.ran, again.skipped) == (0, 3)
+
+
+def test_a_killed_sweep_resumes_where_it_stopped(tmp_path):
+    """Kill the whole sweep (parent and workers) after its first recorded run; rerun: done runs are skipped."""
+    out = tmp_path / "killed"
+    env = {**os.environ, "NUMBA_NUM_THREADS": "1", "PYTHONPATH": os.pathsep.join([str(ROOT), os.environ.get("PYTHONPATH", "")])}
+    proc = subprocess.Popen([sys.executable, "-m", "colonsim.cli", "sweep", "--preset", "smoke", "--workers", "1",
+                             "--out", str(out), "--no-progress"], cwd=ROOT, env=env, start_new_session=True,
+                            stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+    try:
+        deadline = time.monotonic() + 240
+        while not (out / TABLE).is_file():
+            assert proc.poll() is None, proc.stderr.read().decode()
+            assert time.monotonic() < deadline, "the sweep recorded no run in 240 s"
+            time.sleep(0.05)
+    finally:
+        os.killpg(proc.pid, signal.SIGKILL)
+        proc.wait()
+    before = pd.read_parquet(out / TABLE)
+    assert 1 <= len(before) < 3 and (before["status"] == "ok").all()
+    assert (out / ".sweep.lock").is_file()  # left by the killed sweep; the rerun takes it over
+
+    report = run_sweep(SMOKE, out, workers=1, progress=False)
+    assert report.skipped == len(before) and report.ran == 3 - len(before) and report.ok == report.ran
+    table = pd.read_parquet(out / TABLE)
+    assert len(table) == 3 and set(table["key"]) == {c.key() for c in SMOKE}
+    # rows of the first sweep are kept as they were, not rerun
+    kept = table.set_index("key").loc[before["key"], "finished_at"]
+    assert kept.tolist() == before["finished_at"].tolist()
+    assert not (out / ".sweep.lock").exists() and not list(out.glob(f".{TABLE}.*"))
+    check_ok_rows(out, table)
+
+
+def test_failed_runs_are_recorded_and_do_not_stop_the_others(tmp_path):
+    out = tmp_path / "failing"
+    report = run_sweep(SMOKE, out, workers=1, runner=failing_runner, progress=False)
+    assert (report.ran, report.ok, report.failed) == (3, 1, 2)
+    rows = {(r["segment"], r["scope"]): r for r in pd.read_parquet(out / TABLE).to_dict("records")}
+    error = rows[("straight", "pdc")]["error"]
+    assert error == "RuntimeError: injected failure second line"
+    assert rows[("rsj", "utc")]["error"] == DIED  # the pool was replaced and the sweep went on
+    ok = rows[("rsj", "sdc")]
+    assert ok["status"] == "ok" and ok["final_deformation_cm"] > 0
+    for key in (("straight", "pdc"), ("rsj", "utc")):
+        r = rows[key]
+        assert r["status"] == "failed" and r["timeseries_path"] == "" and math.isnan(r["final_deformation_cm"])
+        assert not (out / "runs" / r["key"]).exists()
+    # failed runs count as finished unless asked to retry them (the store test checks the retry set)
+    assert run_sweep(SMOKE, out, workers=1, progress=False).ran == 0
+
+
+def test_store_rows_follow_the_contract_and_the_table_is_replaced_atomically(tmp_path):
+    case = InsertionCase(segment="rsj", scope="10.5", diameter_mm=30.0)
+    outcome = {"key": case.key(), "status": "failed", "error": "ColonsimError: diverged", "wall_time_s": 1.5,
+               "finished_at": "2026-01-01T00:00:00+00:00"}
+    row = result_row(case, outcome)
+    assert row["material"] == "" and row["scope"] == "10.5" and row["scope_diameter_mm"] == pytest.approx(10.5)
+    assert row["quasi_static"] is False and all(math.isnan(row[k]) for k in OUTPUTS if k != "quasi_static")
+    with SweepStore(tmp_path) as store:
+        store.record(case, outcome)
+        assert store.finished() == {case.key()} and store.finished(retry_failed=True) == set()
+    assert sorted(p.name for p in tmp_path.iterdir()) == [TABLE]  # no temporary file, lock released
+    with SweepStore(tmp_path) as store:
+        assert set(store.rows) == {case.key()}
+        assert list(store.table().columns[:len(IDENTITY)]) == list(IDENTITY)
