@@ -306,6 +306,7 @@ def build_parser():
     sub = parser.add_subparsers(dest="command", required=True)
     _add_calibrate(sub)
     _add_insert(sub)
+    __import__("colonsim.cli_surrogate", fromlist=["add_parsers"]).add_parsers(sub)
     demo = sub.add_parser("demo", help="run the workflows on the bundled data (a few minutes on 2 cores)")
     demo.add_argument("--out", type=Path, default=Path("colonsim_demo"), help="output folder (default colonsim_demo)")
     demo.add_argument("--no-progress", action="store_true", help="no progress bar")

@@ -105,7 +105,8 @@ class SweepSurrogate:
         return self
 
     # -- queries -------------------------------------------------------------------------------------
-    def _model(self, segment, target):
+    def model_for(self, segment, target):
+        """The training domain and GP of ``segment`` and ``target``; a one-line error if there is none."""
         segment = str(segment).lower()
         if segment not in self.domains_:
             raise ColonsimError(f"the surrogate has no model of segment {segment!r}; it was fitted on "
@@ -138,7 +139,7 @@ class SweepSurrogate:
         Returns the mean (n,), and with ``return_std`` the standard deviation of a new simulation
         result (trend + run-to-run scatter).
         """
-        domain, gp = self._model(segment, target)
+        domain, gp = self.model_for(segment, target)
         if isinstance(X, np.ndarray):
             X = dict(zip(domain.inputs, np.atleast_2d(X).T))
         elif isinstance(X, pd.DataFrame):
@@ -148,7 +149,7 @@ class SweepSurrogate:
 
     def predict_cov(self, X, segment, target="final_deformation_cm", strict=False):
         """Mean and joint covariance of the smooth trend (no scatter) at the rows of ``X``."""
-        domain, gp = self._model(segment, target)
+        domain, gp = self.model_for(segment, target)
         Xm, _, _ = domain.check(self.query(domain.segment, X), strict=strict)
         return gp.predict(Xm, return_cov=True)
 

@@ -139,3 +139,8 @@ def scope_diameter_mm(spec, known=None) -> float:
     if not 3.0 <= value <= 20.0:
         raise ColonsimError(f"scope diameter {value:g} mm is implausible (3-20 mm); give it in millimetres")
     return value
+
+
+def target_unit(target) -> str:
+    """Unit of an output column, read from its name (``_cm`` -> cm, ``_N`` -> N, else none)."""
+    return {"cm": "cm", "N": "N"}.get(str(target).rsplit("_", 1)[-1], "")
