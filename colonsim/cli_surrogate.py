@@ -35,15 +35,17 @@ def _cv(text):
     return k
 
 
-def _patient_options(p, several_scopes=True):
+def _patient_options(p, scope_diameter=True):
     g = p.add_argument_group("patient: presets (docs/surrogate.md) and raw parameters (raw ones win)")
     g.add_argument("--segment", help="rsj, rsf, thf, thf-fixed (or straight)")
-    g.add_argument("--scope", nargs="+" if several_scopes else None,
+    g.add_argument("--scope", nargs="+",
                    help="utc, pdc, sdc or an outer diameter in mm (default: the scopes of the sweep)")
     g.add_argument("--sex", help="male (0 deg), intermediate (30 deg), female (45 deg): alpha in RSF, beta in THF")
     g.add_argument("--age", help="young (mu 0), middle (0.05), older (0.1, diverticular disease)")
     g.add_argument("--region", help="european (23 mm), african (36 mm): colon diameter in RSJ")
     g.add_argument("--presets", type=Path, help="JSON file overriding the preset tables")
+    if scope_diameter:
+        g.add_argument("--scope-diameter", type=float, help="scope outer diameter, mm (instead of --scope)")
     g.add_argument("--diameter", type=float, help="colon inner diameter, mm")
     g.add_argument("--angle", type=float, help="alpha (RSF) or beta (THF), degrees")
     g.add_argument("--friction", type=float, help="Coulomb friction scope/wall")
@@ -101,7 +103,7 @@ def add_parsers(sub):
                          description="Ranks scopes by predicted deformation and states the probability of the "
                                      "ranking from the joint GP posterior (docs/surrogate.md).")
     rec.add_argument("model", type=Path)
-    _patient_options(rec)
+    _patient_options(rec, scope_diameter=False)
     rec.add_argument("--target", default="final_deformation_cm", help="output to rank by (default final_deformation_cm)")
     rec.add_argument("--reference", help="scope the others are compared with (default sdc)")
     rec.add_argument("--json", action="store_true", help="JSON output")
@@ -262,7 +264,9 @@ def cmd_predict(args):
                             for t in (t, t + "_std", t + "_low95", t + "_high95")])
     shown = [t for t in targets if t in out]
     if not shown:
-        raise ColonsimError(f"no model of {', '.join(targets)} for the segment(s) queried")
+        why = "; ".join(f"{seg} {t}: {model.skipped_.get(seg, {}).get(t, 'not fitted')}"
+                        for seg in dict.fromkeys(out["segment"]) for t in targets)
+        raise ColonsimError(f"no model for this query ({why})")
     if args.out:
         if args.out.suffix.lower() == ".json":
             write_json(args.out, {"predictions": _records(out)})
@@ -284,8 +288,6 @@ def cmd_recommend(args):
 
     model = load_surrogate(args.model)
     segment = _segment(args, model)
-    if args.scope_diameter is not None:
-        raise ColonsimError("recommend compares scopes: give them with --scope, not --scope-diameter")
     query = _patient_query(model, segment, args, _presets(args))
     with _domain_warnings():
         rec = recommend(model, segment, query, scopes=args.scope, target=args.target, reference=args.reference,

@@ -14,6 +14,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from colonsim.errors import ColonsimError
+from surrogate.table import INPUT_OPTIONS
 
 # Relative slack of the bounds (a fraction of the range, or of the value for a fixed input), so
 # that round-off in a query ("9.2" vs 9.200000001) is not "outside".
@@ -62,8 +63,8 @@ class SegmentDomain:
         not used here. A missing model input is an error naming it and its range."""
         missing = [name for name in self.inputs if query.get(name) is None]
         if missing:
-            ranges = ", ".join(f"{m} ({self.low[self.inputs.index(m)]:g}-{self.high[self.inputs.index(m)]:g} in the runs)"
-                               for m in missing)
+            ranges = ", ".join(f"{m} ({self.low[self.inputs.index(m)]:g}-{self.high[self.inputs.index(m)]:g} in the runs; "
+                               f"{INPUT_OPTIONS.get(m, m)} on the command line)" for m in missing)
             raise ColonsimError(f"segment {self.segment}: give {ranges}; the surrogate depends on it")
         cols = [np.atleast_1d(np.asarray(query[name], dtype=float)) for name in self.inputs]
         if n is None:

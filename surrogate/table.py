@@ -21,6 +21,9 @@ INPUTS = ("scope_diameter_mm", "diameter_mm", "angle_deg", "friction", "wall_thi
 INPUT_LABELS = {"scope_diameter_mm": "scope diameter [mm]", "diameter_mm": "colon diameter [mm]",
                 "angle_deg": "angle alpha/beta [deg]", "friction": "friction coefficient",
                 "wall_thickness_mm": "wall thickness [mm]"}
+# How the command line spells each input (for messages).
+INPUT_OPTIONS = {"scope_diameter_mm": "--scope", "diameter_mm": "--diameter", "angle_deg": "--angle",
+                 "friction": "--friction", "wall_thickness_mm": "--wall-thickness"}
 TARGETS = ("final_deformation_cm", "max_deformation_cm", "point_A_cm", "point_C_cm", "peak_contact_force_N",
            "peak_push_force_N", "max_wall_stretch")
 TARGET_LABELS = {"final_deformation_cm": "final colon deformation [cm]", "max_deformation_cm": "maximum colon deformation [cm]",
