@@ -69,6 +69,8 @@ def add_parsers(sub):
     fit.add_argument("--restarts", type=int, default=2, help="extra optimizer starts per GP (default 2)")
     fit.add_argument("--min-runs", type=int, default=4, help="fewest runs a model is fitted on (default 4)")
     fit.add_argument("--seed", type=int, default=0, help="seed of the restarts and folds (default 0)")
+    fit.add_argument("--threads", type=int, default=1,
+                     help="BLAS threads (default 1; more only pays on an idle machine with thousands of runs)")
     fit.set_defaults(func=cmd_fit)
 
     info = ssub.add_parser("info", help="training domain, hyperparameters and cross-validated accuracy of a model")
@@ -133,11 +135,12 @@ def cmd_fit(args):
     from surrogate.store import save_surrogate
     from surrogate.table import TARGETS, read_results
 
-    if args.restarts < 0 or args.min_runs < 2:
-        raise ColonsimError("--restarts must be >= 0 and --min-runs >= 2")
+    if args.restarts < 0 or args.min_runs < 2 or args.threads < 1:
+        raise ColonsimError("--restarts must be >= 0, --min-runs >= 2 and --threads >= 1")
     table = read_results(args.results)
     model = SweepSurrogate(targets=tuple(args.targets or TARGETS), segments=args.segments, cv=args.cv,
-                           n_restarts=args.restarts, min_runs=args.min_runs, random_state=args.seed).fit(table)
+                           n_restarts=args.restarts, min_runs=args.min_runs, random_state=args.seed,
+                           threads=args.threads).fit(table)
     json_path, npz_path = save_surrogate(model, args.out, source=args.results)
     print(model.report())
     print(f"model: {json_path} + {npz_path.name}")

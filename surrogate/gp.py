@@ -16,7 +16,7 @@ from scipy.optimize import minimize
 
 from colonsim.errors import ColonsimError
 from surrogate.kernel import matern52
-from surrogate.likelihood import JITTER, log_marginal_likelihood, squared_differences
+from surrogate.likelihood import JITTER, log_marginal_likelihood
 
 
 class GaussianProcess:
@@ -65,14 +65,17 @@ class GaussianProcess:
         return np.log([self.constant_bounds] + [self.length_scale_bounds] * d + [self.noise_bounds])
 
     def _optimize(self, Xs, ys):
-        sq = squared_differences(Xs)
-        bounds = self._bounds(Xs.shape[1])
-        starts = [np.log([1.0] + [0.5] * Xs.shape[1] + [1e-2])]
+        d = Xs.shape[1]
+        bounds = self._bounds(d)
+        starts = [np.log([1.0] + [0.5] * d + [1e-2])]
+        # restarts log-uniform over plausible values, not the whole box: a start with length
+        # scales of 0.01 (white noise) costs many iterations and never wins
         rng = np.random.default_rng(self.random_state)
-        starts += [rng.uniform(bounds[:, 0], bounds[:, 1]) for _ in range(self.n_restarts)]
+        low, high = np.log([0.1] + [0.1] * d + [1e-4]), np.log([10.0] + [10.0] * d + [0.1])
+        starts += [rng.uniform(low, high) for _ in range(self.n_restarts)]
 
         def objective(theta):
-            value, grad = log_marginal_likelihood(theta, sq, ys)
+            value, grad = log_marginal_likelihood(theta, Xs, ys)
             return (1e25, np.zeros_like(theta)) if not np.isfinite(value) else (-value, -grad)
 
         best = None

@@ -72,7 +72,8 @@ def save_surrogate(model: SweepSurrogate, path, source=None):
            "arrays": {"file": npz_path.name, "sha256": digest},
            "estimator": {"targets": list(model.targets), "inputs": list(model.inputs),
                          "segments": None if model.segments is None else list(model.segments), "cv": model.cv,
-                         "n_restarts": model.n_restarts, "min_runs": model.min_runs, "random_state": model.random_state},
+                         "n_restarts": model.n_restarts, "min_runs": model.min_runs, "random_state": model.random_state,
+                         "threads": model.threads},
            "training": model.training_, "notes": model.notes_, "segments": segments}
     write_json(json_path, doc)
     return json_path, npz_path
@@ -100,7 +101,7 @@ def load_surrogate(path) -> SweepSurrogate:
     est = doc["estimator"]
     model = SweepSurrogate(targets=tuple(est["targets"]), inputs=tuple(est["inputs"]), segments=est["segments"],
                            cv=est["cv"], n_restarts=est["n_restarts"], min_runs=est["min_runs"],
-                           random_state=est["random_state"])
+                           random_state=est["random_state"], threads=est.get("threads", 1))
     model.training_, model.notes_ = doc["training"], list(doc["notes"])
     model.domains_, model.models_, model.cv_, model.skipped_ = {}, {}, {}, {}
     with np.load(npz_path, allow_pickle=False) as arrays:
