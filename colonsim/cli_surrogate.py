@@ -206,10 +206,10 @@ def _query_frame(args, model):
         frame["segment"] = frame["segment"].astype(str).str.lower()
         for col, value in _raw(args).items():
             frame[col] = frame[col].fillna(value) if col in frame else value
-        if args.scope and "scope" not in frame and "scope_diameter_mm" not in frame:
-            frame["scope"] = args.scope[0] if len(args.scope) == 1 else None
-            if len(args.scope) > 1:
-                raise ColonsimError("with --csv give one --scope (or a scope column)")
+        if args.scope and len(args.scope) > 1:
+            raise ColonsimError("with --csv give one --scope (or a scope column)")
+        if args.scope:
+            frame["scope"] = frame["scope"].fillna(args.scope[0]) if "scope" in frame else args.scope[0]
         for i, row in frame.iterrows():  # presets per row, where the row leaves the input empty
             p = patient_inputs(row["segment"], *(row.get(k) if isinstance(row.get(k), str) else getattr(args, k)
                                                   for k in ("sex", "age", "region")), presets=presets)
@@ -316,6 +316,7 @@ def cmd_plot(args):
     segment = _segment(args, model)
     vs = VS_NAMES.get(args.vs.lower(), args.vs)
     query = _patient_query(model, segment, args, _presets(args))
-    fig = prediction_figure(model, segment, vs, query, target=args.target, scopes=args.scope)
+    with _domain_warnings():
+        fig = prediction_figure(model, segment, vs, query, target=args.target, scopes=args.scope, strict=args.strict)
     save_figure(fig, args.out)
     print(f"figure: {args.out}")

@@ -110,8 +110,8 @@ class SweepSurrogate:
                 self.cv_[segment][target] = cross_validate(gp, X, y[keep], self.cv, self._make_gp(domain),
                                                            self.random_state)
         if not any(self.models_.values()):
-            raise ColonsimError("no model could be fitted: " + "; ".join(
-                f"{s} {t}: {why}" for s, d in self.skipped_.items() for t, why in d.items()) or "no successful runs")
+            reasons = "; ".join(f"{s} {t}: {why}" for s, d in self.skipped_.items() for t, why in d.items())
+            raise ColonsimError(f"no model could be fitted ({reasons or 'no successful run in the segments asked for'})")
         return self
 
     # -- queries -------------------------------------------------------------------------------------
@@ -129,15 +129,22 @@ class SweepSurrogate:
         return self.domains_[segment], model
 
     def query(self, segment, values: dict) -> dict:
-        """``values`` with a scope name (key ``scope``) turned into ``scope_diameter_mm``."""
+        """``values`` with scope names (key ``scope``) turned into ``scope_diameter_mm``; a diameter
+        given as well wins, names fill the rows where it is missing (NaN)."""
         values = dict(values)
         scope = values.pop("scope", None)
-        if scope is not None and values.get("scope_diameter_mm") is None:
-            known = self.domains_[segment].scopes if segment in self.domains_ else {}
-            if isinstance(scope, (str, int, float)):
-                values["scope_diameter_mm"] = scope_diameter_mm(scope, known)
-            else:
-                values["scope_diameter_mm"] = np.array([scope_diameter_mm(s, known) for s in scope])
+        if scope is None:
+            return values
+        known = self.domains_[segment].scopes if segment in self.domains_ else {}
+        given = values.get("scope_diameter_mm")
+        if given is None and np.ndim(scope) == 0:  # the common single query
+            values["scope_diameter_mm"] = scope_diameter_mm(scope, known)
+            return values
+        names = np.atleast_1d(np.asarray(scope, dtype=object))
+        from_names = np.array([np.nan if s is None or (isinstance(s, float) and np.isnan(s))
+                               else scope_diameter_mm(s, known) for s in names])
+        values["scope_diameter_mm"] = (from_names if given is None else
+                                       np.where(np.isnan(np.asarray(given, dtype=float)), from_names, given))
         return values
 
     def predict(self, X, segment, target="final_deformation_cm", return_std=False, strict=False):

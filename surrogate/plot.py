@@ -11,12 +11,14 @@ from surrogate.table import INPUT_LABELS, TARGET_LABELS, scope_diameter_mm
 from surrogate.validation import Z95
 
 
-def prediction_figure(model, segment, vs, inputs: dict, target="final_deformation_cm", scopes=None, points=120) -> Figure:
+def prediction_figure(model, segment, vs, inputs: dict, target="final_deformation_cm", scopes=None, points=120,
+                      strict=False) -> Figure:
     """Predicted ``target`` of ``segment`` against the input ``vs`` over its training range.
 
     The other inputs come from ``inputs``; ``scopes`` (default: the sweep's named scopes) give one
     curve each unless ``vs`` is the scope diameter. The band is the 95 % interval of a new
-    simulation result. Training runs that share the other inputs are drawn as dots."""
+    simulation result. Training runs that share the other inputs are drawn as dots. Other inputs
+    outside the training domain: a warning, or an error with ``strict``."""
     domain, gp = model.model_for(segment, target)
     if vs not in domain.inputs:
         raise ColonsimError(f"{domain.segment} does not depend on {vs} in this surrogate; plot against one of "
@@ -35,7 +37,7 @@ def prediction_figure(model, segment, vs, inputs: dict, target="final_deformatio
         if scope is not None:
             query["scope_diameter_mm"] = scope_diameter_mm(scope, domain.scopes)
         query[vs] = grid
-        X, _, _ = domain.check(query, n=points, warn=False)
+        X, _, _ = domain.check(query, n=points, strict=strict)
         mean, std = gp.predict(X, return_std=True)
         label = "prediction" if scope is None else f"{scope.upper()} ({query['scope_diameter_mm']:g} mm)"
         line, = ax.plot(grid, mean, label=label)

@@ -184,3 +184,9 @@ def test_predict_frame_batch(model):
     single = model.predict({"scope": "sdc", "angle_deg": 30.0, "friction": 0.05}, "rsf", return_std=True)
     assert out.loc[1, "final_deformation_cm"] == pytest.approx(single[0][0])
     assert out.loc[1, "final_deformation_cm_high95"] == pytest.approx(single[0][0] + 1.959964 * single[1][0])
+
+
+def test_scope_names_fill_missing_diameters(model):
+    values = model.query("rsj", {"scope": np.array(["utc", None, "sdc"], dtype=object),
+                                 "scope_diameter_mm": np.array([np.nan, 10.0, np.nan])})
+    np.testing.assert_array_equal(values["scope_diameter_mm"], [9.2, 10.0, 12.8])
