@@ -15,9 +15,8 @@ The interval is that of a new simulation result (trend + scatter), the quantity 
 from __future__ import annotations
 
 import numpy as np
-from scipy.linalg import cho_solve
-
 from colonsim.errors import ColonsimError
+from surrogate.likelihood import inverse_from_cholesky
 
 Z95 = 1.959963984540054
 
@@ -33,8 +32,7 @@ def metrics(y, mean, std):
 
 def loo_predictions(gp):
     """Closed-form leave-one-out mean and std (target units) of a fitted :class:`GaussianProcess`."""
-    K_inv = cho_solve((gp.L_, True), np.eye(len(gp.alpha_)), check_finite=False)
-    d = np.diag(K_inv)
+    d = np.diag(inverse_from_cholesky(gp.L_))
     mean = gp.y_mean_ + gp.y_scale_ * (gp.y_train_ - gp.alpha_ / d)
     return mean, gp.y_scale_ / np.sqrt(d)
 
