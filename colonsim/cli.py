@@ -11,6 +11,7 @@ import sys
 import time
 from pathlib import Path
 
+from colonsim import cli_surrogate, cli_sweep
 from colonsim.errors import ColonsimError
 
 REPO_DATA = Path(__file__).resolve().parents[1] / "data"
@@ -308,7 +309,8 @@ def build_parser():
     sub = parser.add_subparsers(dest="command", required=True)
     _add_calibrate(sub)
     _add_insert(sub)
-    __import__("colonsim.cli_sweep").cli_sweep.add_parser(sub)
+    cli_sweep.add_parser(sub)
+    cli_surrogate.add_parsers(sub)
     demo = sub.add_parser("demo", help="run the workflows on the bundled data (a few minutes on 2 cores)")
     demo.add_argument("--out", type=Path, default=Path("colonsim_demo"), help="output folder (default colonsim_demo)")
     demo.add_argument("--no-progress", action="store_true", help="no progress bar")

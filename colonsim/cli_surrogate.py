@@ -1,0 +1,322 @@
+"""Command line of the surrogate: ``colonsim surrogate fit|plot|info``, ``colonsim predict``,
+``colonsim recommend`` (docs/surrogate.md).
+
+Patient presets (--sex, --age, --region) and raw parameters (--angle, --friction, --diameter, ...)
+can be mixed; a raw parameter wins over the preset that would set the same input.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+import warnings
+from contextlib import contextmanager
+from pathlib import Path
+
+from colonsim.errors import ColonsimError
+
+# command-line option -> results-table column
+RAW_OPTIONS = {"scope_diameter": "scope_diameter_mm", "diameter": "diameter_mm", "angle": "angle_deg",
+               "friction": "friction", "wall_thickness": "wall_thickness_mm"}
+VS_NAMES = {"scope": "scope_diameter_mm", "scope-diameter": "scope_diameter_mm", "diameter": "diameter_mm",
+            "angle": "angle_deg", "friction": "friction", "wall-thickness": "wall_thickness_mm"}
+
+
+def _cv(text):
+    if text.lower() == "loo":
+        return "loo"
+    try:
+        k = int(text)
+        if k < 2:
+            raise ValueError
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"--cv takes 'loo' or a number of folds >= 2, got {text!r}")
+    return k
+
+
+def _patient_options(p, scope_diameter=True):
+    g = p.add_argument_group("patient: presets (docs/surrogate.md) and raw parameters (raw ones win)")
+    g.add_argument("--segment", help="rsj, rsf, thf, thf-fixed (or straight)")
+    g.add_argument("--scope", nargs="+",
+                   help="utc, pdc, sdc or an outer diameter in mm (default: the scopes of the sweep)")
+    g.add_argument("--sex", help="male (0 deg), intermediate (30 deg), female (45 deg): alpha in RSF, beta in THF")
+    g.add_argument("--age", help="young (mu 0), middle (0.05), older (0.1, diverticular disease)")
+    g.add_argument("--region", help="european (23 mm), african (36 mm): colon diameter in RSJ")
+    g.add_argument("--presets", type=Path, help="JSON file overriding the preset tables")
+    if scope_diameter:
+        g.add_argument("--scope-diameter", type=float, help="scope outer diameter, mm (instead of --scope)")
+    g.add_argument("--diameter", type=float, help="colon inner diameter, mm")
+    g.add_argument("--angle", type=float, help="alpha (RSF) or beta (THF), degrees")
+    g.add_argument("--friction", type=float, help="Coulomb friction scope/wall")
+    g.add_argument("--wall-thickness", type=float, help="colon wall thickness, mm")
+    g.add_argument("--strict", action="store_true", help="a query outside the training domain is an error, not a warning")
+
+
+def add_parsers(sub):
+    """Add ``surrogate``, ``predict`` and ``recommend`` to the ``colonsim`` subcommands."""
+    s = sub.add_parser("surrogate", help="fit, inspect and plot a GP surrogate of a sweep",
+                       description="Gaussian-process surrogate of a sweep's results table (docs/surrogate.md).")
+    ssub = s.add_subparsers(dest="surrogate_command", required=True)
+    fit = ssub.add_parser("fit", help="fit a surrogate on a results table",
+                          description="Fit one GP per segment and output on the successful runs of RESULTS, "
+                                      "cross-validate it, and write MODEL.json + MODEL.npz.")
+    fit.add_argument("results", type=Path, help="results.parquet (or .csv) of a sweep")
+    fit.add_argument("-o", "--out", type=Path, required=True, help="model path: writes MODEL.json and MODEL.npz")
+    fit.add_argument("--targets", nargs="+", help="output columns to model (default: deformations, A, C, forces, stretch)")
+    fit.add_argument("--segments", nargs="+", help="segments to fit (default: all in the table)")
+    fit.add_argument("--cv", type=_cv, default="loo", help="'loo' (closed-form leave-one-out, default) or k folds")
+    fit.add_argument("--restarts", type=int, default=2, help="extra optimizer starts per GP (default 2)")
+    fit.add_argument("--min-runs", type=int, default=4, help="fewest runs a model is fitted on (default 4)")
+    fit.add_argument("--seed", type=int, default=0, help="seed of the restarts and folds (default 0)")
+    fit.add_argument("--threads", type=int, default=1,
+                     help="BLAS threads (default 1; more only pays on an idle machine with thousands of runs)")
+    fit.set_defaults(func=cmd_fit)
+
+    info = ssub.add_parser("info", help="training domain, hyperparameters and cross-validated accuracy of a model")
+    info.add_argument("model", type=Path)
+    info.add_argument("--json", action="store_true", help="print the model's JSON document")
+    info.set_defaults(func=cmd_info)
+
+    plot = ssub.add_parser("plot", help="predicted output against one input, with its 95 %% band",
+                           description="One curve per scope over the input's training range; the other inputs "
+                                       "from the patient options.")
+    plot.add_argument("model", type=Path)
+    plot.add_argument("--vs", required=True, help="scope, diameter, angle, friction or wall-thickness")
+    plot.add_argument("--target", default="final_deformation_cm", help="output column (default final_deformation_cm)")
+    _patient_options(plot)
+    plot.add_argument("-o", "--out", type=Path, required=True, help="figure file (.png, .pdf, .svg)")
+    plot.set_defaults(func=cmd_plot)
+
+    pr = sub.add_parser("predict", help="predict deformation, forces and stretch from a surrogate",
+                        description="Mean, standard deviation and 95 % interval of each output for the query, "
+                                    "or for every row of --csv.")
+    pr.add_argument("model", type=Path, help="MODEL.json written by 'colonsim surrogate fit'")
+    _patient_options(pr)
+    pr.add_argument("--target", nargs="+", help="outputs to predict (default: all the model has)")
+    pr.add_argument("--csv", type=Path, help="batch queries: one per row, columns segment, scope or "
+                                             "scope_diameter_mm, diameter_mm, angle_deg, friction, "
+                                             "wall_thickness_mm, and/or sex, age, region; options fill missing columns")
+    pr.add_argument("--json", action="store_true", help="JSON output (records) instead of text")
+    pr.add_argument("-o", "--out", type=Path, help="write the predictions to this file (.csv or .json)")
+    pr.set_defaults(func=cmd_predict)
+
+    rec = sub.add_parser("recommend", help="rank the scopes for a patient by predicted deformation",
+                         description="Ranks scopes by predicted deformation and states the probability of the "
+                                     "ranking from the joint GP posterior (docs/surrogate.md).")
+    rec.add_argument("model", type=Path)
+    _patient_options(rec, scope_diameter=False)
+    rec.add_argument("--target", default="final_deformation_cm", help="output to rank by (default final_deformation_cm)")
+    rec.add_argument("--reference", help="scope the others are compared with (default sdc)")
+    rec.add_argument("--json", action="store_true", help="JSON output")
+    rec.add_argument("-o", "--out", type=Path, help="write the JSON recommendation to this file")
+    rec.set_defaults(func=cmd_recommend)
+
+
+@contextmanager
+def _domain_warnings():
+    """Out-of-domain warnings as one ``colonsim: warning:`` line each on stderr."""
+    from surrogate.domain import OutOfDomainWarning
+
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always", OutOfDomainWarning)
+        try:
+            yield
+        finally:
+            for w in caught:
+                if issubclass(w.category, OutOfDomainWarning):
+                    print(f"colonsim: warning: {w.message}", file=sys.stderr)
+                else:
+                    warnings.showwarning(w.message, w.category, w.filename, w.lineno)
+
+
+def cmd_fit(args):
+    from surrogate.model import SweepSurrogate
+    from surrogate.store import save_surrogate
+    from surrogate.table import TARGETS, read_results
+
+    if args.restarts < 0 or args.min_runs < 2 or args.threads < 1:
+        raise ColonsimError("--restarts must be >= 0, --min-runs >= 2 and --threads >= 1")
+    table = read_results(args.results)
+    model = SweepSurrogate(targets=tuple(args.targets or TARGETS), segments=args.segments, cv=args.cv,
+                           n_restarts=args.restarts, min_runs=args.min_runs, random_state=args.seed,
+                           threads=args.threads).fit(table)
+    json_path, npz_path = save_surrogate(model, args.out, source=args.results)
+    print(model.report())
+    print(f"model: {json_path} + {npz_path.name}")
+
+
+def cmd_info(args):
+    from surrogate.store import load_surrogate, model_paths
+
+    model = load_surrogate(args.model)
+    if args.json:
+        print(model_paths(args.model)[0].read_text(encoding="utf-8"), end="")
+    else:
+        print(model.report())
+
+
+def _raw(args):
+    return {col: getattr(args, opt) for opt, col in RAW_OPTIONS.items() if getattr(args, opt, None) is not None}
+
+
+def _presets(args):
+    from surrogate.patients import PatientPresets
+
+    return PatientPresets.from_json(args.presets) if args.presets else PatientPresets()
+
+
+def _segment(args, model):
+    if args.segment:
+        return args.segment.lower()
+    if len(model.domains_) == 1:
+        return next(iter(model.domains_))
+    raise ColonsimError(f"give --segment ({', '.join(model.domains_)})")
+
+
+def _patient_query(model, segment, args, presets):
+    """Model inputs from presets, then raw options on top."""
+    from surrogate.patients import patient_inputs
+
+    return {**patient_inputs(segment, args.sex, args.age, args.region, presets), **_raw(args)}
+
+
+def _query_frame(args, model):
+    """One row per query: from --csv (options fill its missing columns) or from the options, one per scope."""
+    import numpy as np
+    import pandas as pd
+
+    from surrogate.patients import patient_inputs
+    from surrogate.recommend import default_scopes
+
+    presets = _presets(args)
+    if args.csv:
+        if not args.csv.is_file():
+            raise ColonsimError(f"query file {args.csv} not found")
+        try:
+            frame = pd.read_csv(args.csv)
+        except (pd.errors.ParserError, pd.errors.EmptyDataError, UnicodeDecodeError) as exc:
+            raise ColonsimError(f"cannot read {args.csv}: {str(exc).splitlines()[0]}") from None
+        if args.segment:
+            frame = frame.assign(segment=frame["segment"].fillna(args.segment) if "segment" in frame else args.segment)
+        elif "segment" not in frame and len(model.domains_) == 1:
+            frame["segment"] = next(iter(model.domains_))
+        if "segment" not in frame:
+            raise ColonsimError(f"{args.csv} has no segment column; add one or pass --segment")
+        frame["segment"] = frame["segment"].astype(str).str.lower()
+        for col, value in _raw(args).items():
+            frame[col] = frame[col].fillna(value) if col in frame else value
+        if args.scope and len(args.scope) > 1:
+            raise ColonsimError("with --csv give one --scope (or a scope column)")
+        if args.scope:
+            frame["scope"] = frame["scope"].fillna(args.scope[0]) if "scope" in frame else args.scope[0]
+        for i, row in frame.iterrows():  # presets per row, where the row leaves the input empty
+            p = patient_inputs(row["segment"], *(row.get(k) if isinstance(row.get(k), str) else getattr(args, k)
+                                                  for k in ("sex", "age", "region")), presets=presets)
+            for col, value in p.items():
+                if col not in frame or pd.isna(frame.at[i, col]):
+                    frame.loc[i, col] = value
+        return frame.drop(columns=[c for c in ("sex", "age", "region") if c in frame])
+    segment = _segment(args, model)
+    base = {"segment": segment, **_patient_query(model, segment, args, presets)}
+    scopes = args.scope
+    if not scopes and "scope_diameter_mm" not in base and segment in model.domains_:
+        domain = model.domains_[segment]
+        scopes = default_scopes(domain) if "scope_diameter_mm" in domain.inputs else None
+    rows = [{**base, "scope": s} for s in scopes] if scopes else [base]
+    return pd.DataFrame(rows).replace({np.nan: None})
+
+
+def _records(frame):
+    import numpy as np
+
+    return [{k: (None if isinstance(v, float) and np.isnan(v) else v) for k, v in row.items()}
+            for row in frame.to_dict(orient="records")]
+
+
+def _format_predictions(out, targets):
+    from surrogate.table import INPUTS, target_unit
+
+    lines = []
+    for _, row in out.iterrows():
+        inputs = ", ".join(f"{c} {row[c]:g}" for c in INPUTS if c in row and row[c] is not None and row[c] == row[c])
+        scope = f" {str(row['scope']).upper()}" if "scope" in row and isinstance(row["scope"], str) else ""
+        lines.append(f"{row['segment'].upper()}{scope}: {inputs}" + ("" if row["in_domain"] else "  [OUTSIDE the training domain]"))
+        for t in targets:
+            if row[t] == row[t]:
+                unit = target_unit(t)
+                lines.append(f"  {t:<22} {row[t]:8.4g} +- {row[t + '_std']:.2g} {unit}  "
+                             f"(95 %: {row[t + '_low95']:.4g} to {row[t + '_high95']:.4g})")
+    lines.append("(+- one standard deviation of a new simulation result; the interval is mean +- 1.96 sd)")
+    return "\n".join(lines)
+
+
+def cmd_predict(args):
+    from colonsim.files import write_csv, write_json
+    from surrogate.store import load_surrogate
+
+    model = load_surrogate(args.model)
+    frame = _query_frame(args, model)
+    targets = list(args.target or model.targets)
+    unknown = sorted(set(targets) - set(model.targets))
+    if unknown:
+        raise ColonsimError(f"the surrogate has no target {', '.join(unknown)}; it models {', '.join(model.targets)}")
+    with _domain_warnings():
+        out = model.predict_frame(frame, targets=targets, strict=args.strict)
+    out = out.drop(columns=[t for t in targets if out[t].isna().all()
+                            for t in (t, t + "_std", t + "_low95", t + "_high95")])
+    shown = [t for t in targets if t in out]
+    if not shown:
+        why = "; ".join(f"{seg} {t}: {model.skipped_.get(seg, {}).get(t, 'not fitted')}"
+                        for seg in dict.fromkeys(out["segment"]) for t in targets)
+        raise ColonsimError(f"no model for this query ({why})")
+    if args.out:
+        if args.out.suffix.lower() == ".json":
+            write_json(args.out, {"predictions": _records(out)})
+        else:
+            write_csv(args.out, out)
+    if args.json:
+        print(json.dumps({"predictions": _records(out)}, indent=2, allow_nan=False, default=str))
+    else:
+        print(_format_predictions(out, shown))
+        if args.out:
+            print(f"predictions: {args.out}")
+
+
+def cmd_recommend(args):
+    from colonsim.files import write_json
+    from surrogate.patients import describe_patient
+    from surrogate.recommend import format_recommendation, recommend
+    from surrogate.store import load_surrogate
+
+    model = load_surrogate(args.model)
+    segment = _segment(args, model)
+    query = _patient_query(model, segment, args, _presets(args))
+    with _domain_warnings():
+        rec = recommend(model, segment, query, scopes=args.scope, target=args.target, reference=args.reference,
+                        strict=args.strict)
+    patient = describe_patient(segment, args.sex, args.age, args.region, _presets(args))
+    rec["patient"] = patient
+    if args.out:
+        write_json(args.out, rec)
+    if args.json:
+        print(json.dumps(rec, indent=2, allow_nan=False))
+    else:
+        if patient:
+            print(f"patient: {patient}")
+        print(format_recommendation(rec))
+
+
+def cmd_plot(args):
+    from colonsim.files import save_figure
+    from surrogate.plot import prediction_figure
+    from surrogate.store import load_surrogate
+
+    model = load_surrogate(args.model)
+    segment = _segment(args, model)
+    vs = VS_NAMES.get(args.vs.lower(), args.vs)
+    query = _patient_query(model, segment, args, _presets(args))
+    with _domain_warnings():
+        fig = prediction_figure(model, segment, vs, query, target=args.target, scopes=args.scope, strict=args.strict)
+    save_figure(fig, args.out)
+    print(f"figure: {args.out}")

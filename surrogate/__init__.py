@@ -1,0 +1,15 @@
+"""Surrogate of an insertion sweep: Gaussian-process regression of the scalar outcomes.
+
+Data flow: results table (one row per run) -> :class:`SweepSurrogate` (one GP per segment and
+output, cross-validated at fit time) -> JSON + NPZ files (:func:`save_surrogate`,
+:func:`load_surrogate`, no pickle) -> predictions with uncertainty, patient presets and scope
+recommendations. See docs/surrogate.md.
+"""
+
+from surrogate.domain import OutOfDomainWarning, SegmentDomain
+from surrogate.gp import GaussianProcess
+from surrogate.model import SweepSurrogate
+from surrogate.table import INPUTS, SEGMENTS, TARGETS, read_results
+
+__all__ = ["GaussianProcess", "INPUTS", "OutOfDomainWarning", "SEGMENTS", "SegmentDomain", "SweepSurrogate",
+           "TARGETS", "read_results"]

@@ -1,0 +1,137 @@
+"""Gaussian-process regression of one scalar output, scikit-learn estimator style.
+
+Kernel ``ConstantKernel * Matern(nu=2.5, length_scale=[one per input]) + WhiteKernel``: a smooth
+trend whose per-input length scales say how strongly each input matters (a length scale far above
+1 = the output barely depends on that input), plus white noise for the run-to-run scatter of the
+simulations. Inputs are scaled to [0, 1] over ``input_range`` (default: the training data), the
+target is standardized. Hyperparameters maximize the log marginal likelihood (L-BFGS-B with
+restarts); prediction is numpy from the stored Cholesky factor, so it needs no scikit-learn.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from scipy.linalg import cho_solve, cholesky, solve_triangular
+from scipy.optimize import minimize
+
+from colonsim.errors import ColonsimError
+from surrogate.kernel import matern52
+from surrogate.likelihood import JITTER, log_marginal_likelihood
+
+
+class GaussianProcess:
+    """GP regression of one output on a few continuous inputs.
+
+    Parameters
+    ----------
+    input_range : (low, high) arrays or None
+        Interval of each input mapped onto [0, 1]; default the training data's min and max.
+    constant_bounds, length_scale_bounds, noise_bounds : (float, float)
+        Bounds of the signal variance, of the length scales (in scaled inputs, so 1 = the
+        training range) and of the noise variance (both variances in units of the target's variance).
+    n_restarts : int
+        Optimizer runs from random log-uniform starting points, besides the default start.
+    random_state : int
+        Seed of the restarts.
+    """
+
+    def __init__(self, input_range=None, constant_bounds=(1e-2, 1e2), length_scale_bounds=(1e-2, 1e2),
+                 noise_bounds=(1e-6, 1.0), n_restarts=2, random_state=0):
+        self.input_range = input_range
+        self.constant_bounds = constant_bounds
+        self.length_scale_bounds = length_scale_bounds
+        self.noise_bounds = noise_bounds
+        self.n_restarts = n_restarts
+        self.random_state = random_state
+
+    # -- fitting -----------------------------------------------------------------------------------
+    def fit(self, X, y):
+        """Fit hyperparameters and condition on ``(X, y)``; returns self."""
+        X, y = np.atleast_2d(np.asarray(X, dtype=float)), np.asarray(y, dtype=float).ravel()
+        if len(X) != len(y) or len(y) < 2:
+            raise ColonsimError(f"a GP needs at least 2 runs with matching inputs and outputs, got {len(X)} and {len(y)}")
+        low, high = (X.min(axis=0), X.max(axis=0)) if self.input_range is None else map(np.asarray, self.input_range)
+        self.x_low_ = np.asarray(low, dtype=float)
+        self.x_span_ = np.where(np.asarray(high) > low, np.asarray(high) - low, 1.0)
+        self.y_mean_ = float(y.mean())
+        self.y_scale_ = float(y.std()) or 1.0
+        Xs = self.scale(X)
+        ys = (y - self.y_mean_) / self.y_scale_
+        theta = self._optimize(Xs, ys)
+        self._condition(Xs, ys, theta)
+        return self
+
+    def _bounds(self, d):
+        return np.log([self.constant_bounds] + [self.length_scale_bounds] * d + [self.noise_bounds])
+
+    def _optimize(self, Xs, ys):
+        d = Xs.shape[1]
+        bounds = self._bounds(d)
+        starts = [np.log([1.0] + [0.5] * d + [1e-2])]
+        # restarts log-uniform over plausible values, not the whole box: a start with length
+        # scales of 0.01 (white noise) costs many iterations and never wins
+        rng = np.random.default_rng(self.random_state)
+        low, high = np.log([0.1] + [0.1] * d + [1e-4]), np.log([10.0] + [10.0] * d + [0.1])
+        starts += [rng.uniform(low, high) for _ in range(self.n_restarts)]
+
+        def objective(theta):
+            value, grad = log_marginal_likelihood(theta, Xs, ys)
+            return (1e25, np.zeros_like(theta)) if not np.isfinite(value) else (-value, -grad)
+
+        best = None
+        for start in starts:
+            res = minimize(objective, np.clip(start, bounds[:, 0], bounds[:, 1]), jac=True, method="L-BFGS-B",
+                           bounds=bounds)
+            if best is None or res.fun < best.fun:
+                best = res
+        self.log_marginal_likelihood_ = float(-best.fun)
+        return best.x
+
+    def _condition(self, Xs, ys, theta):
+        """Store what prediction needs: training inputs, hyperparameters, Cholesky factor, alpha."""
+        self.X_train_ = Xs
+        self.y_train_ = ys
+        self.constant_ = float(np.exp(theta[0]))
+        self.length_scale_ = np.exp(theta[1:-1])
+        self.noise_level_ = float(np.exp(theta[-1]))
+        K = self.constant_ * matern52(Xs, Xs, self.length_scale_)
+        K[np.diag_indices_from(K)] += self.noise_level_ + JITTER
+        self.L_ = cholesky(K, lower=True, check_finite=False)
+        self.alpha_ = cho_solve((self.L_, True), ys, check_finite=False)
+
+    # -- prediction --------------------------------------------------------------------------------
+    def scale(self, X):
+        """Inputs in physical units -> [0, 1] over the input range."""
+        return (np.asarray(X, dtype=float) - self.x_low_) / self.x_span_
+
+    def predict(self, X, return_std=False, return_cov=False, include_noise=True):
+        """Posterior mean at the rows of ``X`` (physical units), in target units.
+
+        ``return_std``: also the standard deviation; with ``include_noise`` (default) that of a new
+        simulation result (trend + run-to-run scatter, what the cross-validation checks), without it
+        that of the smooth trend alone. ``return_cov``: the joint covariance of the trend at the rows
+        (used to compare scopes for one patient); noise is never in it.
+        """
+        Xs = self.scale(np.atleast_2d(X))
+        k = self.constant_ * matern52(Xs, self.X_train_, self.length_scale_)
+        mean = self.y_mean_ + self.y_scale_ * (k @ self.alpha_)
+        if not (return_std or return_cov):
+            return mean
+        v = solve_triangular(self.L_, k.T, lower=True, check_finite=False)
+        if return_cov:
+            cov = self.constant_ * matern52(Xs, Xs, self.length_scale_) - v.T @ v
+            return mean, cov * self.y_scale_**2
+        var = self.constant_ - np.einsum("ij,ij->j", v, v)
+        if include_noise:
+            var = var + self.noise_level_
+        return mean, self.y_scale_ * np.sqrt(np.maximum(var, 0.0))
+
+    @property
+    def noise_std(self):
+        """Standard deviation of the run-to-run scatter, target units."""
+        return self.y_scale_ * np.sqrt(self.noise_level_)
+
+    @property
+    def kernel_description(self):
+        ls = ", ".join(f"{v:.3g}" for v in self.length_scale_)
+        return f"{self.constant_:.3g} * Matern(length_scale=[{ls}], nu=2.5) + WhiteKernel({self.noise_level_:.3g})"

@@ -1,0 +1,33 @@
+"""The Matern 5/2 covariance with one length scale per input, in plain numpy.
+
+The same function as scikit-learn's ``Matern(length_scale=[...], nu=2.5)``, written out so that a
+saved surrogate predicts with numpy alone (no scikit-learn, no pickle) and a single query costs
+microseconds rather than the ~0.2 ms of an estimator call.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+SQRT5 = np.sqrt(5.0)
+
+
+def scaled_distance(XA, XB, length_scale):
+    """Euclidean distance between the rows of ``XA`` (m, d) and ``XB`` (n, d), each input divided by
+    its length scale; (m, n)."""
+    A = np.asarray(XA, dtype=float) / length_scale
+    B = np.asarray(XB, dtype=float) / length_scale
+    # |a - b|^2 = |a|^2 + |b|^2 - 2 a.b: one matrix product instead of an (m, n, d) tensor
+    sq = np.einsum("ij,ij->i", A, A)[:, None] + np.einsum("ij,ij->i", B, B)[None, :] - 2.0 * (A @ B.T)
+    return np.sqrt(np.maximum(sq, 0.0))
+
+
+def matern52_of_distance(r):
+    """Matern 5/2 correlation (1 + sqrt5 r + 5/3 r^2) exp(-sqrt5 r) of a scaled distance ``r``."""
+    s = SQRT5 * r
+    return (1.0 + s + s * s / 3.0) * np.exp(-s)
+
+
+def matern52(XA, XB, length_scale):
+    """Matern 5/2 correlation matrix between the rows of ``XA`` and ``XB`` (unit variance)."""
+    return matern52_of_distance(scaled_distance(XA, XB, length_scale))

@@ -1,0 +1,233 @@
+"""The surrogate of a sweep: one GP per colon segment and output, fitted on the results table.
+
+``SweepSurrogate(...).fit(table)`` returns the fitted estimator; ``predict(query, segment, target,
+return_std=True)`` answers in microseconds. Learned state lives in attributes ending with ``_``:
+``domains_`` (segment -> :class:`SegmentDomain`), ``models_`` (segment -> target ->
+:class:`GaussianProcess`), ``cv_`` (segment -> target -> cross-validation metrics), ``skipped_``
+(segment -> target -> why no model), ``notes_`` (things about the table a user should know).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+
+from colonsim.errors import ColonsimError
+from surrogate.domain import SegmentDomain
+from surrogate.gp import GaussianProcess
+from surrogate.table import (INPUTS, TARGETS, check_results, scope_diameter_mm, scope_diameters, solver_settings,
+                             split_inputs, successful_runs)
+from surrogate.validation import Z95, cross_validate
+
+
+class SweepSurrogate:
+    """Gaussian-process surrogate of a sweep, per segment and per output.
+
+    Parameters
+    ----------
+    targets : sequence of str
+        Output columns to model (default :data:`surrogate.table.TARGETS`); a segment whose runs
+        leave a target undefined (NaN, e.g. points A and C outside RSJ) gets no model for it.
+    inputs : sequence of str
+        Candidate input columns; those constant over a segment's runs are recorded as fixed.
+    segments : sequence of str or None
+        Segments to fit (default: all in the table).
+    cv : "loo" or int
+        Cross-validation scheme run at fit time (see :mod:`surrogate.validation`).
+    n_restarts : int
+        Extra optimizer starts of each GP's hyperparameters.
+    min_runs : int
+        Fewer successful runs with a value than this: no model for that segment and target.
+    random_state : int
+    threads : int or None
+        BLAS threads during the fit (default 1). The matrices are small (runs x runs): on a machine
+        shared with simulations, more BLAS threads contend for the cores and made a 500-run fit
+        four times slower in the benchmark. None leaves the BLAS default.
+    """
+
+    def __init__(self, targets=TARGETS, inputs=INPUTS, segments=None, cv="loo", n_restarts=2, min_runs=4,
+                 random_state=0, threads=1):
+        self.targets = targets
+        self.inputs = inputs
+        self.segments = segments
+        self.cv = cv
+        self.n_restarts = n_restarts
+        self.min_runs = min_runs
+        self.random_state = random_state
+        self.threads = threads
+
+    def _make_gp(self, domain):
+        return lambda: GaussianProcess(input_range=(domain.low, domain.high), n_restarts=self.n_restarts,
+                                       random_state=self.random_state)
+
+    def fit(self, table: pd.DataFrame):
+        """Fit every (segment, target) model on the runs with status "ok"; returns self."""
+        from threadpoolctl import threadpool_limits
+
+        with threadpool_limits(limits=self.threads, user_api="blas"):
+            return self._fit(check_results(table))
+
+    def _fit(self, table):
+        if self.cv != "loo" and not (isinstance(self.cv, (int, np.integer)) and self.cv >= 2):
+            raise ColonsimError(f"cv must be 'loo' or a number of folds >= 2, got {self.cv!r}")
+        unknown = sorted(set(self.targets) - set(table.columns))
+        if unknown:
+            raise ColonsimError(f"the results table has no column {', '.join(unknown)}; choose targets among its outputs")
+        segments = self.segments or [s for s in dict.fromkeys(table["segment"]) if (table["segment"] == s).any()]
+        self.domains_, self.models_, self.cv_, self.skipped_, self.notes_ = {}, {}, {}, {}, []
+        self.training_ = {"runs": int(len(table)), "ok": int((table["status"] == "ok").sum()),
+                          "failed": int((table["status"] != "ok").sum())}
+        for segment in segments:
+            runs = successful_runs(table, segment)
+            if runs.empty:
+                self.notes_.append(f"{segment}: no successful run, no model")
+                continue
+            varying, fixed = split_inputs(runs, self.inputs)
+            settings, varying_settings = solver_settings(runs)
+            low = runs[varying].min().to_numpy(dtype=float) if varying else np.zeros(0)
+            high = runs[varying].max().to_numpy(dtype=float) if varying else np.zeros(0)
+            domain = SegmentDomain(segment, varying, low, high, fixed, len(runs), scope_diameters(runs), settings)
+            self.domains_[segment] = domain
+            if varying_settings:
+                self.notes_.append(f"{segment}: solver setting(s) {', '.join(varying_settings)} vary between runs; "
+                                   "they are not inputs, so their effect shows up as scatter")
+            if "quasi_static" in runs.columns and (runs["quasi_static"] == False).any():  # noqa: E712 (NaN-safe)
+                self.notes_.append(f"{segment}: {int((runs['quasi_static'] == False).sum())} of {len(runs)} runs "  # noqa: E712
+                                   "were not quasi-static (KE/IE check); they train like the others")
+            self.models_[segment], self.cv_[segment], self.skipped_[segment] = {}, {}, {}
+            for target in self.targets:
+                y = runs[target].to_numpy(dtype=float)
+                keep = np.isfinite(y)
+                if not varying:
+                    self.skipped_[segment][target] = "no input varies over the runs"
+                elif keep.sum() < self.min_runs:
+                    self.skipped_[segment][target] = f"{int(keep.sum())} runs with a value (< {self.min_runs})"
+                if target in self.skipped_[segment]:
+                    continue
+                X = runs.loc[keep, varying].to_numpy(dtype=float)
+                gp = self._make_gp(domain)().fit(X, y[keep])
+                self.models_[segment][target] = gp
+                self.cv_[segment][target] = cross_validate(gp, X, y[keep], self.cv, self._make_gp(domain),
+                                                           self.random_state)
+        if not any(self.models_.values()):
+            reasons = "; ".join(f"{s} {t}: {why}" for s, d in self.skipped_.items() for t, why in d.items())
+            raise ColonsimError(f"no model could be fitted ({reasons or 'no successful run in the segments asked for'})")
+        return self
+
+    # -- queries -------------------------------------------------------------------------------------
+    def model_for(self, segment, target):
+        """The training domain and GP of ``segment`` and ``target``; a one-line error if there is none."""
+        segment = str(segment).lower()
+        if segment not in self.domains_:
+            raise ColonsimError(f"the surrogate has no model of segment {segment!r}; it was fitted on "
+                                f"{', '.join(self.domains_)}")
+        model = self.models_[segment].get(target)
+        if model is None:
+            why = self.skipped_[segment].get(target, "not among the fitted targets")
+            raise ColonsimError(f"no {target} model for {segment} ({why}); choose --target among "
+                                f"{', '.join(self.models_[segment]) or 'none'}")
+        return self.domains_[segment], model
+
+    def query(self, segment, values: dict) -> dict:
+        """``values`` with scope names (key ``scope``) turned into ``scope_diameter_mm``; a diameter
+        given as well wins, names fill the rows where it is missing (NaN)."""
+        values = dict(values)
+        scope = values.pop("scope", None)
+        if scope is None:
+            return values
+        known = self.domains_[segment].scopes if segment in self.domains_ else {}
+        given = values.get("scope_diameter_mm")
+        if given is None and np.ndim(scope) == 0:  # the common single query
+            values["scope_diameter_mm"] = scope_diameter_mm(scope, known)
+            return values
+        names = np.atleast_1d(np.asarray(scope, dtype=object))
+        from_names = np.array([np.nan if s is None or (isinstance(s, float) and np.isnan(s))
+                               else scope_diameter_mm(s, known) for s in names])
+        values["scope_diameter_mm"] = (from_names if given is None else
+                                       np.where(np.isnan(np.asarray(given, dtype=float)), from_names, given))
+        return values
+
+    def predict(self, X, segment, target="final_deformation_cm", return_std=False, strict=False):
+        """Predicted ``target`` for ``segment`` at the query ``X``.
+
+        ``X``: a mapping input name -> scalar or array (``scope`` may name a scope), a DataFrame
+        with those columns, or an (n, d) array in the order of ``domains_[segment].inputs``.
+        Outside the training domain: :class:`OutOfDomainWarning`, or an error with ``strict``.
+        Returns the mean (n,), and with ``return_std`` the standard deviation of a new simulation
+        result (trend + run-to-run scatter).
+        """
+        domain, gp = self.model_for(segment, target)
+        if isinstance(X, np.ndarray):
+            X = dict(zip(domain.inputs, np.atleast_2d(X).T))
+        elif isinstance(X, pd.DataFrame):
+            X = {c: X[c].to_numpy() for c in X.columns}
+        Xm, _, _ = domain.check(self.query(domain.segment, X), strict=strict)
+        return gp.predict(Xm, return_std=return_std)
+
+    def predict_cov(self, X, segment, target="final_deformation_cm", strict=False):
+        """Mean and joint covariance of the smooth trend (no scatter) at the rows of ``X``."""
+        domain, gp = self.model_for(segment, target)
+        Xm, _, _ = domain.check(self.query(domain.segment, X), strict=strict)
+        return gp.predict(Xm, return_cov=True)
+
+    def predict_frame(self, frame: pd.DataFrame, targets=None, segment=None, strict=False) -> pd.DataFrame:
+        """Batch prediction: one row per query row, per target its mean, std and 95 % interval.
+
+        ``frame`` holds input columns (and ``segment`` unless given). Targets a segment has no model
+        of are NaN. Columns ``in_domain`` and ``domain_note`` say which rows extrapolate."""
+        frame = frame.reset_index(drop=True)
+        if segment is not None:
+            frame = frame.assign(segment=segment)
+        if "segment" not in frame.columns:
+            raise ColonsimError("the queries lack a segment column; add one or pass --segment")
+        frame = frame.assign(segment=frame["segment"].astype(str).str.strip().str.lower())
+        targets = list(targets or self.targets)
+        out = frame.copy()
+        out["in_domain"], out["domain_note"] = True, ""
+        for t in targets:
+            for suffix in ("", "_std", "_low95", "_high95"):
+                out[t + suffix] = np.nan
+        for seg, rows in frame.groupby("segment", sort=False):
+            if seg not in self.domains_:
+                raise ColonsimError(f"the surrogate has no model of segment {seg!r}; it was fitted on {', '.join(self.domains_)}")
+            domain = self.domains_[seg]
+            values = self.query(seg, {c: rows[c].to_numpy() for c in rows.columns if c != "segment"})
+            Xm, inside, note = domain.check(values, n=len(rows), strict=strict)
+            out.loc[rows.index, "in_domain"] = inside
+            out.loc[rows.index, "domain_note"] = note
+            if values.get("scope_diameter_mm") is not None:
+                out.loc[rows.index, "scope_diameter_mm"] = values["scope_diameter_mm"]
+            for t in targets:
+                gp = self.models_[seg].get(t)
+                if gp is None:
+                    continue
+                mean, std = gp.predict(Xm, return_std=True)
+                out.loc[rows.index, t] = mean
+                out.loc[rows.index, t + "_std"] = std
+                out.loc[rows.index, t + "_low95"] = mean - Z95 * std
+                out.loc[rows.index, t + "_high95"] = mean + Z95 * std
+        return out
+
+    # -- description ---------------------------------------------------------------------------------
+    def report(self) -> str:
+        """Training domain, hyperparameters and cross-validated accuracy, as text."""
+        lines = [f"trained on {self.training_['ok']} successful runs ({self.training_['failed']} failed runs ignored)"]
+        for seg, domain in self.domains_.items():
+            lines.append(domain.describe())
+            for target, gp in self.models_[seg].items():
+                cv = self.cv_[seg][target]
+                scales = ", ".join(f"{n} {v:.2g}" for n, v in zip(domain.inputs, gp.length_scale_))
+                lines.append(f"  {target:<22} n {cv['n']:>3}  CV RMSE {cv['rmse']:.3g}  max {cv['max_abs_error']:.3g}  "
+                             f"95% coverage {100 * cv['coverage_95']:.0f} %  Q2 {cv['q2'] if cv['q2'] is None else round(cv['q2'], 3)}  "
+                             f"scatter sd {gp.noise_std:.2g}  length scales ({scales})")
+            for target, why in self.skipped_[seg].items():
+                lines.append(f"  {target:<22} no model: {why}")
+        lines.extend(f"note: {n}" for n in self.notes_)
+        if self.domains_:
+            first = next(iter(self.cv_.values()), {})
+            scheme = next(iter(first.values()), {}).get("scheme")
+            if scheme:
+                lines.append(f"cross-validation: {scheme}; length scales are in units of the training range "
+                             "(>> 1: the output barely depends on that input)")
+        return "\n".join(lines)
+

@@ -1,0 +1,88 @@
+"""Rank scopes for one patient by predicted colon deformation, and say how sure the ranking is.
+
+The scopes differ only in diameter, so their predictions are strongly correlated: the GP is
+uncertain about the overall level for this patient far more than about the difference between
+two scope diameters. Treating the predictions as independent would understate the confidence.
+The probabilities below therefore use the joint posterior of the GP's smooth trend at the scopes'
+query points (mean and full covariance). The run-to-run scatter (white-noise term) is left out:
+the question is which scope deforms this colon less on average, not which of two single runs does.
+
+- ``p_less_than_reference``: P(deformation of this scope < deformation of the reference scope,
+  SDC by default) = Phi((mu_ref - mu) / sqrt(var + var_ref - 2 cov)), exact for the Gaussian.
+- ``p_best``: P(this scope deforms least), and ``p_ranking``: P(the whole stated order holds),
+  both from draws of the joint Gaussian.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from scipy.special import ndtr
+
+from colonsim.errors import ColonsimError
+from surrogate.table import NAMED_SCOPES_MM, STANDARD_SCOPE, scope_diameter_mm, target_unit
+from surrogate.validation import Z95
+
+
+def default_scopes(domain):
+    """The named scopes the sweep ran (UTC, PDC, SDC or its own), else the three of SPEC.md 2.2."""
+    named = {k: v for k, v in domain.scopes.items() if k in NAMED_SCOPES_MM}
+    return list(named or domain.scopes or NAMED_SCOPES_MM)
+
+
+def recommend(model, segment, inputs: dict, scopes=None, target="final_deformation_cm", reference=None,
+              strict=False, n_draws=20000, seed=0) -> dict:
+    """Scopes for a patient (``inputs`` without the scope) ranked by predicted ``target``.
+
+    Returns a JSON-ready dict: per scope the mean, std and 95 % interval of the trend, the rank,
+    ``p_best`` and ``p_less_than_reference``; overall ``p_ranking``; the domain check."""
+    domain, gp = model.model_for(segment, target)
+    if "scope_diameter_mm" not in domain.inputs:
+        raise ColonsimError(f"segment {domain.segment} was trained on one scope diameter only "
+                            f"({domain.fixed.get('scope_diameter_mm', '?')} mm); fit on a sweep over scopes to rank them")
+    scopes = [str(s).strip().lower() for s in (scopes or default_scopes(domain))]
+    if len(set(scopes)) < 2:
+        raise ColonsimError("give at least two different scopes to rank")
+    diameters = np.array([scope_diameter_mm(s, domain.scopes) for s in scopes])
+    if reference is None:
+        reference = STANDARD_SCOPE if STANDARD_SCOPE in scopes else scopes[int(np.argmax(diameters))]
+    reference = str(reference).lower()
+    if reference not in scopes:
+        raise ColonsimError(f"reference scope {reference} is not among the scopes ranked ({', '.join(scopes)})")
+    query = {k: v for k, v in inputs.items() if k not in ("scope", "scope_diameter_mm")}
+    query["scope_diameter_mm"] = diameters
+    X, inside, notes = domain.check(query, n=len(scopes), strict=strict)
+    mean, cov = gp.predict(X, return_cov=True)
+    var = np.maximum(np.diag(cov), 0.0)
+    r = scopes.index(reference)
+    diff_sd = np.sqrt(np.maximum(var + var[r] - 2.0 * cov[:, r], 1e-300))
+    p_less = ndtr((mean[r] - mean) / diff_sd)
+    order = np.argsort(mean, kind="stable")
+    draws = np.random.default_rng(seed).multivariate_normal(mean, cov, size=n_draws, method="eigh")
+    p_best = np.bincount(np.argmin(draws, axis=1), minlength=len(scopes)) / n_draws
+    p_ranking = float(np.mean(np.all(np.diff(draws[:, order], axis=1) > 0, axis=1)))
+    std = np.sqrt(var)
+    rows = [{"scope": scopes[i], "diameter_mm": float(diameters[i]), "rank": int(np.flatnonzero(order == i)[0]) + 1,
+             "mean": float(mean[i]), "std": float(std[i]), "low95": float(mean[i] - Z95 * std[i]),
+             "high95": float(mean[i] + Z95 * std[i]), "p_best": float(p_best[i]),
+             "p_less_than_reference": None if i == r else float(p_less[i]),
+             "in_domain": bool(inside[i]), "domain_note": notes[i]} for i in order]
+    return {"segment": domain.segment, "target": target, "inputs": {k: float(np.asarray(v)) for k, v in query.items()
+                                                                   if k != "scope_diameter_mm"},
+            "reference": reference, "ranking": [scopes[i] for i in order], "p_ranking": p_ranking, "scopes": rows,
+            "uncertainty": "joint GP posterior of the smooth trend at the scopes (covariance included); "
+                           "run-to-run scatter excluded", "in_domain": bool(inside.all())}
+
+
+def format_recommendation(rec) -> str:
+    """The recommendation as a few lines of text."""
+    unit = target_unit(rec["target"])
+    lines = [f"{rec['segment'].upper()}, {rec['target']}: " + " < ".join(s.upper() for s in rec["ranking"])
+             + f"  (probability this order holds: {100 * rec['p_ranking']:.0f} %)"]
+    for s in rec["scopes"]:
+        vs = ("" if s["p_less_than_reference"] is None
+              else f"  P(less than {rec['reference'].upper()}) {100 * s['p_less_than_reference']:.0f} %")
+        lines.append(f"  {s['rank']}. {s['scope'].upper():>5} ({s['diameter_mm']:g} mm): {s['mean']:.3g} {unit} "
+                     f"[95 % {s['low95']:.3g}, {s['high95']:.3g}]  P(least) {100 * s['p_best']:.0f} %{vs}"
+                     + ("" if s["in_domain"] else f"  OUTSIDE the training domain: {s['domain_note']}"))
+    lines.append(f"  ({rec['uncertainty']})")
+    return "\n".join(lines)

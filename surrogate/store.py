@@ -1,0 +1,123 @@
+"""Save a fitted surrogate to open files and load it back without pickle.
+
+``MODEL.json`` (readable): format and version, the estimator's settings, per segment the training
+domain, per output the kernel hyperparameters, scaling, cross-validation metrics, and the name and
+SHA-256 of the arrays file. ``MODEL.npz`` (numpy arrays, read with ``allow_pickle=False``): per
+segment and output the scaled training inputs, the standardized training outputs, ``alpha`` =
+K^-1 y and the lower Cholesky factor L of K. That is everything prediction needs: loading neither
+refits nor imports scikit-learn.
+"""
+
+from __future__ import annotations
+
+import datetime
+import hashlib
+import json
+from pathlib import Path
+
+import numpy as np
+
+from colonsim import __version__
+from colonsim.errors import ColonsimError
+from colonsim.files import atomic_path, write_json
+from surrogate.domain import SegmentDomain
+from surrogate.gp import GaussianProcess
+from surrogate.model import SweepSurrogate
+
+FORMAT = "colonsim-surrogate"
+FORMAT_VERSION = "1.0"
+ARRAYS = ("X_train", "y_train", "alpha", "L")
+
+
+def model_paths(path):
+    """The JSON and NPZ paths of a model named ``path`` (``model``, ``model.json`` or ``model.npz``)."""
+    path = Path(path)
+    base = path.with_suffix("") if path.suffix.lower() in (".json", ".npz") else path
+    return base.with_name(base.name + ".json"), base.with_name(base.name + ".npz")
+
+
+def _key(segment, target, name):
+    return f"{segment}__{target}__{name}"
+
+
+def _sha256(path):
+    return hashlib.sha256(Path(path).read_bytes()).hexdigest()
+
+
+def save_surrogate(model: SweepSurrogate, path, source=None):
+    """Write ``model`` as ``<path>.json`` + ``<path>.npz``; returns the two paths."""
+    json_path, npz_path = model_paths(path)
+    arrays, segments = {}, {}
+    for seg, domain in model.domains_.items():
+        entries = {}
+        for target, gp in model.models_[seg].items():
+            for name in ARRAYS:
+                arrays[_key(seg, target, name)] = getattr(gp, name + "_")
+            entries[target] = {
+                "kernel": gp.kernel_description,
+                "constant": gp.constant_, "noise_level": gp.noise_level_,
+                "length_scale": dict(zip(domain.inputs, gp.length_scale_.tolist())),
+                "x_low": gp.x_low_.tolist(), "x_span": gp.x_span_.tolist(),
+                "y_mean": gp.y_mean_, "y_scale": gp.y_scale_, "noise_std": gp.noise_std,
+                "log_marginal_likelihood": gp.log_marginal_likelihood_, "n_train": int(len(gp.alpha_)),
+                "cross_validation": model.cv_[seg][target],
+            }
+        segments[seg] = {"domain": domain.to_dict(), "models": entries, "skipped": model.skipped_[seg]}
+    with atomic_path(npz_path) as tmp:
+        np.savez(tmp, **arrays)
+        digest = _sha256(tmp)
+    doc = {"format": FORMAT, "format_version": FORMAT_VERSION, "colonsim_version": __version__,
+           "created": datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds"),
+           "source": None if source is None else str(source),
+           "arrays": {"file": npz_path.name, "sha256": digest},
+           "estimator": {"targets": list(model.targets), "inputs": list(model.inputs),
+                         "segments": None if model.segments is None else list(model.segments), "cv": model.cv,
+                         "n_restarts": model.n_restarts, "min_runs": model.min_runs, "random_state": model.random_state,
+                         "threads": model.threads},
+           "training": model.training_, "notes": model.notes_, "segments": segments}
+    write_json(json_path, doc)
+    return json_path, npz_path
+
+
+def load_surrogate(path) -> SweepSurrogate:
+    """Read a surrogate written by :func:`save_surrogate` (no pickle, no refit)."""
+    json_path, npz_path = model_paths(path)
+    if not json_path.is_file():
+        raise ColonsimError(f"surrogate file {json_path} not found; write one with 'colonsim surrogate fit RESULTS -o MODEL'")
+    try:
+        doc = json.loads(json_path.read_text(encoding="utf-8"))
+    except (json.JSONDecodeError, UnicodeDecodeError) as exc:
+        raise ColonsimError(f"{json_path} is not valid JSON ({exc}); refit the surrogate") from None
+    if not isinstance(doc, dict) or doc.get("format") != FORMAT:
+        raise ColonsimError(f"{json_path} is not a colonsim surrogate (no 'format': '{FORMAT}')")
+    if str(doc.get("format_version", "")).split(".")[0] != FORMAT_VERSION.split(".")[0]:
+        raise ColonsimError(f"{json_path} has surrogate format {doc.get('format_version')}, this colonsim reads "
+                            f"{FORMAT_VERSION}; refit it with this version")
+    npz_path = json_path.with_name(doc["arrays"]["file"])
+    if not npz_path.is_file():
+        raise ColonsimError(f"arrays file {npz_path} of {json_path} is missing; keep the .json and .npz together")
+    if _sha256(npz_path) != doc["arrays"]["sha256"]:
+        raise ColonsimError(f"{npz_path} does not belong to {json_path} (checksum differs); copy both files of one fit")
+    est = doc["estimator"]
+    model = SweepSurrogate(targets=tuple(est["targets"]), inputs=tuple(est["inputs"]), segments=est["segments"],
+                           cv=est["cv"], n_restarts=est["n_restarts"], min_runs=est["min_runs"],
+                           random_state=est["random_state"], threads=est.get("threads", 1))
+    model.training_, model.notes_ = doc["training"], list(doc["notes"])
+    model.domains_, model.models_, model.cv_, model.skipped_ = {}, {}, {}, {}
+    with np.load(npz_path, allow_pickle=False) as arrays:
+        for seg, entry in doc["segments"].items():
+            domain = SegmentDomain.from_dict(entry["domain"])
+            model.domains_[seg] = domain
+            model.models_[seg], model.cv_[seg], model.skipped_[seg] = {}, {}, dict(entry["skipped"])
+            for target, m in entry["models"].items():
+                gp = GaussianProcess(input_range=(domain.low, domain.high))
+                gp.x_low_, gp.x_span_ = np.asarray(m["x_low"], dtype=float), np.asarray(m["x_span"], dtype=float)
+                gp.y_mean_, gp.y_scale_ = float(m["y_mean"]), float(m["y_scale"])
+                gp.constant_, gp.noise_level_ = float(m["constant"]), float(m["noise_level"])
+                gp.length_scale_ = np.array([m["length_scale"][n] for n in domain.inputs], dtype=float)
+                gp.log_marginal_likelihood_ = float(m["log_marginal_likelihood"])
+                for name in ARRAYS:
+                    setattr(gp, name + "_", arrays[_key(seg, target, name)])
+                model.models_[seg][target] = gp
+                model.cv_[seg][target] = m["cross_validation"]
+    return model
