@@ -206,8 +206,8 @@ def cmd_demo(args):
     cases = [InsertionCase(segment="rsj", scope=s, diameter_mm=36.0, material=material) for s in ("utc", "pdc", "sdc")]
     run_insertions(cases, out / "insertion", show=not args.no_progress)
     print(f"\ndemo finished in {time.perf_counter() - t0:.0f} s; outputs in {out}/")
-    print("Not there yet: insertion sweeps and the surrogate pain predictor (issue 5), notebooks and the "
-          "validation report (issue 6).")
+    print("Next: `colonsim sweep --preset thesis` runs the source's 39 insertions, `colonsim surrogate fit` "
+          "fits the surrogate on its results.parquet, `colonsim recommend` ranks the scopes for a patient.")
 
 
 def _add_insert(sub):
