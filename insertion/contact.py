@@ -328,10 +328,11 @@ class RodShellContact:
         so as the wall stiffens (:meth:`follow_wall`).
     held_stiffness : float or None
         Penalty stiffness per held (fixed) wall node, N/m. A held node does not move, so its
-        spring loads the rod alone and the wall's light nodes need not limit it. None: four held
+        spring loads the rod alone and the wall's light nodes need not limit it. None: sixteen held
         springs on the lightest rod node add what one free spring adds to the lightest wall node
-        (``stiffness * m_rod_min / (4 m_wall_min)``, never less than ``stiffness``). A soft spring
-        on a held node would let a hard-pushed scope sink through the fixed end rings.
+        (``stiffness * m_rod_min / (16 m_wall_min)``, never less than ``stiffness``; with four, a
+        7.5 mm wall mesh went unstable between two time-step updates). A soft spring on a held
+        node would let a hard-pushed scope sink through the fixed end rings.
     damping_ratio : float
         Fraction zeta of critical damping of each contact spring.
     friction : float
@@ -395,7 +396,7 @@ class RodShellContact:
         return 0.25 * float(self.shell.mass.min()) * wall_omega2
 
     def _held_penalty(self, free):
-        return free * max(1.0, float(self.rod.mass.min()) / (4.0 * float(self.shell.mass.min())))
+        return free * max(1.0, float(self.rod.mass.min()) / (16.0 * float(self.shell.mass.min())))
 
     def follow_wall(self, body_omega2):
         """Penalties left to their defaults follow the wall's current highest squared frequency
