@@ -87,8 +87,8 @@ def markdown(rows, exit_length, wall, rate):
         "",
         "## Reading the differences",
         "",
-        "- Point A (the tip negotiating the angulation) comes out 10-25 % below the source with the source's "
-        "orderings (SDC > PDC > UTC, D23 > D36). The final deformation (point C) is 1.5-2.2x below the source; "
+        "- Point A (the tip negotiating the angulation) comes out 13-25 % below the source with the source's "
+        "orderings (SDC > PDC > UTC, D23 > D36). The final deformation (point C) is 1.5-2.3x below the source; "
         "at D = 36 mm all three scopes are within a factor of 2, keep the source's order and have C > A.",
         "- A run ends when the tip crosses the plane of the fixed end ring (SPEC.md 2.4). A stiff scope rounds "
         "the 180 deg arc on a wider path than the centerline, so the closest-point position along the "
