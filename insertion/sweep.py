@@ -236,13 +236,19 @@ def dask_outcomes(cases, address, runner=None, log=print):
     core): runs within a worker process are serialized anyway. Each worker loads the kernels
     once, at its first run (outside the timed part), which also covers workers that join late.
     """
-    from distributed import Client, as_completed
+    from distributed import Client
 
-    try:
+    try:  # connect now, so an unreachable scheduler fails before anything is written
         client = Client(address, timeout="15s", set_as_default=False)
     except (OSError, TimeoutError) as exc:
         raise ColonsimError(f"cannot reach the Dask scheduler at {address} ({exc}); start one with "
                             f"`dask scheduler` and workers with `dask worker {address} --nthreads 1`") from None
+    return _dask_stream(client, cases, address, runner, log)
+
+
+def _dask_stream(client, cases, address, runner, log):
+    from distributed import as_completed
+
     with client:
         workers = client.scheduler_info().get("workers", {})
         if not workers:
@@ -313,15 +319,17 @@ def run_sweep(cases, out, workers=2, scheduler=None, runner=None, retry_failed=F
     out = Path(out)
     t0 = time.perf_counter()
     with SweepStore(out) as store:
-        if spec is not None:
-            write_json(out / "sweep.json", spec.document())
         done = store.finished(retry_failed)
         todo = [c for c in cases if c.key() not in done]
         skipped = len(cases) - len(todo)
         ok = failed = 0
-        if todo:
+        outcomes = None
+        if todo:  # a Dask client connects here: an unreachable scheduler fails before sweep.json is written
             outcomes = (dask_outcomes(todo, scheduler, runner, log) if scheduler
                         else local_outcomes(todo, min(workers, len(todo)), runner))
+        if spec is not None:
+            write_json(out / "sweep.json", spec.document())
+        if outcomes is not None:
             from tqdm import tqdm
 
             bar = tqdm(total=len(todo), unit="run", disable=None if progress else True, dynamic_ncols=True,

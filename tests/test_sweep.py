@@ -143,3 +143,31 @@ def test_store_rows_follow_the_contract_and_the_table_is_replaced_atomically(tmp
     with SweepStore(tmp_path) as store:
         assert set(store.rows) == {case.key()}
         assert list(store.table().columns[:len(IDENTITY)]) == list(IDENTITY)
+
+
+def test_an_unreachable_scheduler_fails_before_anything_is_written(tmp_path):
+    import socket
+
+    from colonsim.errors import ColonsimError
+    from insertion.sweep_spec import parse_sweep
+
+    with socket.socket() as s:  # a loopback port nobody listens on
+        s.bind(("127.0.0.1", 0))
+        port = s.getsockname()[1]
+    spec = parse_sweep('[sweep]\nname = "x"\n[[grid]]\nsegment = "rsj"\nscope = "utc"\n')
+    out = tmp_path / "sweep"
+    with pytest.raises(ColonsimError, match="cannot reach the Dask scheduler"):
+        run_sweep(spec.cases, out, scheduler=f"tcp://127.0.0.1:{port}", spec=spec, progress=False)
+    assert not (out / "sweep.json").exists() and not (out / TABLE).exists()
+
+
+def test_result_files_get_the_mode_of_a_plain_open(tmp_path):
+    from colonsim.files import write_json
+
+    mask = os.umask(0o022)
+    try:
+        write_json(tmp_path / "a.json", {"x": 1})
+        (tmp_path / "b.json").write_text("{}")
+    finally:
+        os.umask(mask)
+    assert (tmp_path / "a.json").stat().st_mode & 0o777 == (tmp_path / "b.json").stat().st_mode & 0o777 == 0o644
