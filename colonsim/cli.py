@@ -8,7 +8,6 @@ from __future__ import annotations
 
 import argparse
 import sys
-import time
 from pathlib import Path
 
 from colonsim import cli_surrogate, cli_sweep
@@ -187,27 +186,11 @@ def cmd_calibrate(args):
 
 
 def cmd_demo(args):
-    t0 = time.perf_counter()
-    out = args.out
-    print("colonsim demo: calibrate Mooney-Rivlin parameters from the bundled SYNTHETIC tensile data "
-          "(data/README.md), reduced budget (--quick).", flush=True)
-    cal = argparse.Namespace(manifest=None, curve=None, length=None, width=None, thickness=None,
-                             displacement_unit=None, force_unit=None, per_specimen=False, law="mooney_rivlin_3",
-                             analytic=False, mesh=(8, 3), points=20, quick=True, seed=1, workers=1,
-                             no_progress=args.no_progress)
-    run_calibration(cal, out / "calibration")
+    from colonsim.demo import run_demo
 
-    from insertion.scenario import InsertionCase
-
-    print("\ncolonsim demo: RSJ insertions (D = 36 mm, mu = 0) of the three scopes with the material just "
-          "calibrated. PRELIMINARY: the insertion model is still being validated against the source "
-          "(benchmarks/bench_insertion.py prints the comparison).", flush=True)
-    material = str(out / "calibration" / "material.json")
-    cases = [InsertionCase(segment="rsj", scope=s, diameter_mm=36.0, material=material) for s in ("utc", "pdc", "sdc")]
-    run_insertions(cases, out / "insertion", show=not args.no_progress)
-    print(f"\ndemo finished in {time.perf_counter() - t0:.0f} s; outputs in {out}/")
-    print("Next: `colonsim sweep --preset thesis` runs the source's 39 insertions, `colonsim surrogate fit` "
-          "fits the surrogate on its results.parquet, `colonsim recommend` ranks the scopes for a patient.")
+    if args.workers is not None and args.workers < 1:
+        raise ColonsimError(f"--workers {args.workers}; give at least 1")
+    run_demo(args)
 
 
 def _add_insert(sub):
@@ -313,6 +296,9 @@ def build_parser():
     cli_surrogate.add_parsers(sub)
     demo = sub.add_parser("demo", help="run the workflows on the bundled data (a few minutes on 2 cores)")
     demo.add_argument("--out", type=Path, default=Path("colonsim_demo"), help="output folder (default colonsim_demo)")
+    demo.add_argument("--element-size", type=float, default=3.0,
+                      help="wall mesh of the insertions and the sweep, mm (default 3; coarser is faster, not validated)")
+    demo.add_argument("--workers", type=int, default=None, help="processes for the demo's sweep (default: up to 2 cores)")
     demo.add_argument("--no-progress", action="store_true", help="no progress bar")
     demo.set_defaults(func=cmd_demo)
     return parser

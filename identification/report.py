@@ -22,6 +22,7 @@ import pandas as pd
 from matplotlib.figure import Figure
 
 from colonsim.files import save_figure, write_csv, write_json
+from colonsim.provenance import code_version
 from identification.laws import get_law
 from identification.pipeline import CalibrationResult
 
@@ -64,7 +65,7 @@ def material_document(result: CalibrationResult, level=0.95) -> dict:
         "specimen": {"name": result.curve.name, "length_mm": result.curve.length * 1e3,
                      "width_mm": result.curve.width * 1e3, "thickness_mm": result.curve.thickness * 1e3,
                      **result.curve.meta},
-        "provenance": {"tool": "colonsim calibrate", "version": _version(),
+        "provenance": {"tool": "colonsim calibrate", "version": _version(), **code_version(),
                        "date": _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds"),
                        **result.settings},
     }

@@ -34,6 +34,7 @@ from dataclasses import asdict, dataclass
 import numpy as np
 
 from colonsim.errors import ColonsimError
+from colonsim.provenance import code_version
 from insertion.colon_segments import colon_geometry
 from insertion.contact import RodShellContact
 from insertion.manoeuvre import PushProfile, continuous_push, straighten_relax_push
@@ -274,6 +275,7 @@ def summarize(model: Insertion, ts, wall_s, build_s) -> dict:
     return {
         "inputs": model.case.to_dict(),
         "key": model.case.key(),
+        "code": code_version(),
         "scope": {**model.scope.describe(), "length_cm": float(model.rod.rest_length.sum() * 100)},
         "pushed_depth_cm": float(ts["depth_m"].iloc[-1] * 100),
         "tip_end_cm": float(model.tip_end * 100),

@@ -18,6 +18,7 @@ from pathlib import Path
 import numpy as np
 
 from colonsim import __version__
+from colonsim.provenance import code_version
 from colonsim.errors import ColonsimError
 from colonsim.files import atomic_path, write_json
 from surrogate.domain import SegmentDomain
@@ -67,6 +68,7 @@ def save_surrogate(model: SweepSurrogate, path, source=None):
         np.savez(tmp, **arrays)
         digest = _sha256(tmp)
     doc = {"format": FORMAT, "format_version": FORMAT_VERSION, "colonsim_version": __version__,
+           "git_commit": code_version()["git_commit"],
            "created": datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds"),
            "source": None if source is None else str(source),
            "arrays": {"file": npz_path.name, "sha256": digest},
