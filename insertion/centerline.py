@@ -6,9 +6,13 @@ A centerline is a chain of pieces, each tagged ``"fixed"`` (retroperitoneal, hel
 fillet arc of radius ``fillet_radius`` (**assumption** of SPEC.md 2.1, so the tube has no crease),
 trimming ``R_f tan(|angle|/2)`` off each neighbour.
 
-Fillet rule (**assumption**): a fillet is fixed when either neighbour is fixed (the attachment
-of the fixed segment reaches the junction), mobile only between two mobile pieces. It takes the
-neighbours' name when both share one (the bottom of the transverse V) and ``"a-b fillet"`` else.
+Fillet rule (**assumption**): a fillet between two pieces of the same tag takes that tag; between
+a fixed and a mobile piece it is split at its middle (the corner of the unrounded centerline,
+where the fixation ends) and each half goes with its own neighbour, so a mobile segment keeps its
+length and carries its half of the bend. (Tagging the whole fillet fixed, as an earlier version
+did, put every bend of the RSF model in fixed tissue: the scope then passed the tilted sigmoid
+without deforming it at any angle.) A fillet takes the neighbours' name when both share one (the
+bottom of the transverse V) and ``"a-b fillet"`` else.
 
 Frames are rotation-minimising (parallel transport): the normal ``n`` never spins about the
 tangent, so rings of a tube mesh placed with ``(n, b)`` do not twist. On a planar centerline
@@ -158,9 +162,12 @@ def resolve_pieces(pieces, fillet_radius=FILLET_RADIUS):
             if piece.angle == 0.0:
                 continue
             before, after = items[i - 1], items[i + 1]
-            tag = "fixed" if "fixed" in (before.tag, after.tag) else "mobile"
             name = before.name if before.name == after.name else f"{before.name}-{after.name} fillet"
-            out.append(Arc(radius_of[i], piece.angle, tag, name, piece.roll))
+            if before.tag == after.tag:
+                out.append(Arc(radius_of[i], piece.angle, before.tag, name, piece.roll))
+            else:  # the attachment is at the corner: each half of the bend goes with its own neighbour
+                out.append(Arc(radius_of[i], 0.5 * piece.angle, before.tag, name, piece.roll))
+                out.append(Arc(radius_of[i], 0.5 * piece.angle, after.tag, name, 0.0))
         else:
             out.append(piece)
     # Two straights with nothing between them (a zero kink) are one piece of the same segment.

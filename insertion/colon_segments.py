@@ -67,17 +67,28 @@ class ColonGeometry:
 
 
 def _mobile_axes(centerline, mesh, name):
-    """(direction (3,), node indices) per straight piece called ``name``: its mobile nodes and
-    those of the arcs (fillets) after it, which may only move along the straight."""
-    groups = []
-    for i, piece in enumerate(centerline.pieces):
-        if piece.name != name:
+    """(direction (3,), node indices) per straight piece called ``name``: its mobile nodes and those
+    of the mobile arcs (fillets) next to it, which may only move along the straight. An arc joins
+    the straight before it in its run of mobile pieces, or the one after it if none precedes."""
+    pieces = centerline.pieces
+    groups, owner, waiting = [], {}, []
+    for i, piece in enumerate(pieces):
+        if piece.tag != "mobile":
+            waiting = []  # a fixed piece ends the run: arcs before it stay unconstrained
+            owner.pop("last", None)
             continue
-        if isinstance(piece, Straight):
-            groups.append((centerline.tangent(centerline.s_start[i]), [i]))
-        elif groups:
-            groups[-1][1].append(i)
-    axes = [(d, np.flatnonzero(mesh.mobile & np.isin(mesh.piece, pieces))) for d, pieces in groups]
+        if isinstance(piece, Straight) and piece.name == name:
+            groups.append((centerline.tangent(centerline.s_start[i]), [i, *waiting]))
+            waiting = []
+            owner["last"] = len(groups) - 1
+        elif isinstance(piece, Straight):
+            waiting = []
+            owner.pop("last", None)
+        elif "last" in owner and i > 0 and pieces[i - 1].tag == "mobile":
+            groups[owner["last"]][1].append(i)
+        else:
+            waiting.append(i)
+    axes = [(d, np.flatnonzero(mesh.mobile & np.isin(mesh.piece, idx))) for d, idx in groups]
     return [(d, nodes) for d, nodes in axes if nodes.size]
 
 

@@ -35,6 +35,7 @@ import pandas as pd
 
 from colonsim.errors import ColonsimError
 from colonsim.files import atomic_path, write_json
+from colonsim.provenance import code_version
 from insertion.scenario import InsertionCase, InsertionResult
 from insertion.scopes import colonoscope
 from insertion.sweep_worker import execute, start_worker
@@ -42,7 +43,7 @@ from insertion.sweep_worker import execute, start_worker
 TABLE = "results.parquet"
 LOCK = ".sweep.lock"
 DIED = "worker process died during this run (killed or out of memory)"
-IDENTITY = ("key", "status", "error", "wall_time_s", "timeseries_path", "finished_at")
+IDENTITY = ("key", "status", "error", "wall_time_s", "timeseries_path", "finished_at", "git_commit")
 OUTPUTS = ("final_deformation_cm", "max_deformation_cm", "point_A_cm", "point_B_cm", "point_C_cm",
            "peak_contact_force_N", "peak_push_force_N", "max_wall_stretch", "quasi_static", "simulated_time_s")
 
@@ -82,7 +83,8 @@ def result_row(case, outcome, timeseries_path="") -> dict:
     ok = outcome["status"] == "ok"
     return {"key": case.key(), "status": outcome["status"], "error": outcome.get("error", ""),
             "wall_time_s": float(outcome["wall_time_s"]), "timeseries_path": timeseries_path if ok else "",
-            "finished_at": outcome["finished_at"], **_inputs(case), **_outputs(outcome.get("summary") if ok else None)}
+            "finished_at": outcome["finished_at"], "git_commit": code_version()["git_commit"] or "",
+            **_inputs(case), **_outputs(outcome.get("summary") if ok else None)}
 
 
 class SweepStore:
@@ -139,6 +141,17 @@ class SweepStore:
     def finished(self, retry_failed=False) -> set:
         """Keys that need no new run: ok runs, and failed ones unless ``retry_failed``."""
         return {k for k, r in self.rows.items() if r["status"] == "ok" or (r["status"] == "failed" and not retry_failed)}
+
+    def other_code(self, keys) -> dict:
+        """Commit -> number of the rows ``keys`` that another version of the code produced (rows
+        without a recorded commit, or runs outside a git checkout, are not counted)."""
+        mine = code_version()["git_commit"]
+        counts = {}
+        for k in keys:
+            commit = self.rows[k].get("git_commit")
+            if mine and isinstance(commit, str) and commit and commit != mine:
+                counts[commit] = counts.get(commit, 0) + 1
+        return counts
 
     def record(self, case, outcome) -> dict:
         """Write the run folder (ok runs), then the table with the run's row; return the row."""
@@ -322,6 +335,10 @@ def run_sweep(cases, out, workers=2, scheduler=None, runner=None, retry_failed=F
         done = store.finished(retry_failed)
         todo = [c for c in cases if c.key() not in done]
         skipped = len(cases) - len(todo)
+        other = store.other_code({c.key() for c in cases} & done)
+        if other:
+            log(f"note: {sum(other.values())} finished run(s) in {out} were made by other code "
+                f"({', '.join(c[:12] for c in other)}) and are kept; rerun into a new --out to redo them with this code")
         ok = failed = 0
         outcomes = None
         if todo:  # a Dask client connects here: an unreachable scheduler fails before sweep.json is written

@@ -148,9 +148,21 @@ def test_tags_and_names():
     mid = 0.5 * np.add(*c.bounds("sigmoid"))
     assert c.tag_at(mid) == "mobile" and c.name_at(mid) == "sigmoid"
     assert c.tag_at(0.01) == "fixed" and c.name_at(0.01) == "rectum"
-    # fillet rule: fixed when a neighbour is fixed
-    assert c.name_at(c.bounds("rectum")[1] + 1e-6) == "rectum-sigmoid fillet"
-    assert c.tag_at(c.bounds("rectum")[1] + 1e-6) == "fixed"
+    # fillet rule: between a fixed and a mobile piece, each half of the fillet goes with its neighbour,
+    # split at the corner of the unrounded centerline, so the sigmoid keeps its 20 cm
+    a = np.radians(30.0)
+    rectum_end = c.bounds("rectum")[1]
+    assert c.name_at(rectum_end + 1e-6) == "rectum-sigmoid fillet"
+    assert c.tag_at(rectum_end + 1e-6) == "fixed"
+    corner = rectum_end + 0.5 * FILLET_RADIUS * a
+    assert list(c.tag_at(np.array([corner - 1e-6, corner + 1e-6]))) == ["fixed", "mobile"]
+    mobile = [p for p in c.pieces if p.tag == "mobile"]
+    mobile_length = sum(p.length if isinstance(p, Straight) else p.radius * abs(p.angle) for p in mobile)
+    # sigmoid 20 cm minus two tangent trims R tan(a/2), plus two half fillets R a / 2
+    assert mobile_length == pytest.approx(0.20 - 2 * FILLET_RADIUS * (np.tan(0.5 * a) - 0.5 * a), rel=1e-12)
+    # the split point is the fillet's middle, R (1/cos(a/2) - 1) from the unrounded corner at y = 4 cm
+    gap = np.linalg.norm(c.position(corner) - [0.0, 0.04, 0.0])
+    assert gap == pytest.approx(FILLET_RADIUS * (1 / np.cos(0.5 * a) - 1), rel=1e-9)
     assert list(c.tag_at(np.array([0.0, mid, c.length]))) == ["fixed", "mobile", "fixed"]
     thf = thf_centerline(30.0)
     assert thf.tag_at(0.5 * np.add(*thf.bounds("transverse"))) == "mobile"

@@ -118,7 +118,8 @@ def test_tags_and_end_rings():
     assert not np.any(mesh.mobile & mesh.end_ring)
     rsf = MESHES["rsf45"]()
     names = np.array([p.name for p in rsf.centerline.pieces])[rsf.piece]
-    assert set(names[rsf.mobile]) == {"sigmoid"}
+    # the sigmoid and the mobile halves of the fillets at its ends
+    assert set(names[rsf.mobile]) == {"sigmoid", "rectum-sigmoid fillet", "sigmoid-descending fillet"}
     assert not tube_mesh(thf_fixed_centerline(30.0), 0.036, H).mobile.any()
 
 
