@@ -11,6 +11,12 @@ the question is which scope deforms this colon less on average, not which of two
   SDC by default) = Phi((mu_ref - mu) / sqrt(var + var_ref - 2 cov)), exact for the Gaussian.
 - ``p_best``: P(this scope deforms least), and ``p_ranking``: P(the whole stated order holds),
   both from draws of the joint Gaussian.
+
+Where the patient coincides with simulated cases, the posterior of the trend is nearly exact and
+the probabilities above approach 0 or 1: they then restate the simulations, not the surrogate's
+accuracy. The ``..._with_cv_error`` variants add to every scope an independent error with the
+output's leave-one-out RMSE (measured at fit time). Independent errors are a pessimistic reading
+(errors at one patient are correlated across scopes), so the two numbers bracket the confidence.
 """
 
 from __future__ import annotations
@@ -26,7 +32,8 @@ from surrogate.validation import Z95
 def default_scopes(domain):
     """The named scopes the sweep ran (UTC, PDC, SDC or its own), else the three of SPEC.md 2.2."""
     named = {k: v for k, v in domain.scopes.items() if k in NAMED_SCOPES_MM}
-    return list(named or domain.scopes or NAMED_SCOPES_MM)
+    table = named or domain.scopes or NAMED_SCOPES_MM
+    return sorted(table, key=lambda name: table[name])  # thinnest first
 
 
 def recommend(model, segment, inputs: dict, scopes=None, target="final_deformation_cm", reference=None,
@@ -60,15 +67,21 @@ def recommend(model, segment, inputs: dict, scopes=None, target="final_deformati
     draws = np.random.default_rng(seed).multivariate_normal(mean, cov, size=n_draws, method="eigh")
     p_best = np.bincount(np.argmin(draws, axis=1), minlength=len(scopes)) / n_draws
     p_ranking = float(np.mean(np.all(np.diff(draws[:, order], axis=1) > 0, axis=1)))
+    cv_rmse = float(model.cv_[domain.segment][target]["rmse"])
+    noisy = draws + np.random.default_rng(seed + 1).normal(0.0, cv_rmse, size=draws.shape)
+    p_ranking_cv = float(np.mean(np.all(np.diff(noisy[:, order], axis=1) > 0, axis=1)))
+    p_less_cv = np.mean(noisy < noisy[:, [r]], axis=0)
     std = np.sqrt(var)
     rows = [{"scope": scopes[i], "diameter_mm": float(diameters[i]), "rank": int(np.flatnonzero(order == i)[0]) + 1,
              "mean": float(mean[i]), "std": float(std[i]), "low95": float(mean[i] - Z95 * std[i]),
              "high95": float(mean[i] + Z95 * std[i]), "p_best": float(p_best[i]),
              "p_less_than_reference": None if i == r else float(p_less[i]),
+             "p_less_than_reference_with_cv_error": None if i == r else float(p_less_cv[i]),
              "in_domain": bool(inside[i]), "domain_note": notes[i]} for i in order]
     return {"segment": domain.segment, "target": target, "inputs": {k: float(np.asarray(v)) for k, v in query.items()
                                                                    if k != "scope_diameter_mm"},
-            "reference": reference, "ranking": [scopes[i] for i in order], "p_ranking": p_ranking, "scopes": rows,
+            "reference": reference, "ranking": [scopes[i] for i in order], "p_ranking": p_ranking,
+            "cv_rmse": cv_rmse, "p_ranking_with_cv_error": p_ranking_cv, "scopes": rows,
             "uncertainty": "joint GP posterior of the smooth trend at the scopes (covariance included); "
                            "run-to-run scatter excluded", "in_domain": bool(inside.all())}
 
@@ -77,10 +90,13 @@ def format_recommendation(rec) -> str:
     """The recommendation as a few lines of text."""
     unit = target_unit(rec["target"])
     lines = [f"{rec['segment'].upper()}, {rec['target']}: " + " < ".join(s.upper() for s in rec["ranking"])
-             + f"  (probability this order holds: {100 * rec['p_ranking']:.0f} %)"]
+             + f"  (probability this order holds: {100 * rec['p_ranking']:.0f} %; "
+             f"{100 * rec['p_ranking_with_cv_error']:.0f} % allowing the surrogate's cross-validated error of "
+             f"{rec['cv_rmse']:.2g} {unit} per scope)"]
     for s in rec["scopes"]:
         vs = ("" if s["p_less_than_reference"] is None
-              else f"  P(less than {rec['reference'].upper()}) {100 * s['p_less_than_reference']:.0f} %")
+              else f"  P(less than {rec['reference'].upper()}) {100 * s['p_less_than_reference']:.0f} % "
+                   f"({100 * s['p_less_than_reference_with_cv_error']:.0f} % with CV error)")
         lines.append(f"  {s['rank']}. {s['scope'].upper():>5} ({s['diameter_mm']:g} mm): {s['mean']:.3g} {unit} "
                      f"[95 % {s['low95']:.3g}, {s['high95']:.3g}]  P(least) {100 * s['p_best']:.0f} %{vs}"
                      + ("" if s["in_domain"] else f"  OUTSIDE the training domain: {s['domain_note']}"))

@@ -161,6 +161,10 @@ def test_recommend_ranks_by_diameter_with_confidence(model):
     by_scope = {s["scope"]: s for s in rec["scopes"]}
     assert by_scope["utc"]["p_less_than_reference"] > 0.99 and by_scope["sdc"]["p_less_than_reference"] is None
     assert rec["p_ranking"] > 0.99 and by_scope["utc"]["p_best"] > 0.99
+    # adding the cross-validated error per scope can only make the order less sure
+    assert rec["cv_rmse"] == pytest.approx(model.cv_["rsj"]["final_deformation_cm"]["rmse"])
+    assert 0.0 < rec["p_ranking_with_cv_error"] <= rec["p_ranking"] + 0.01
+    assert by_scope["utc"]["p_less_than_reference_with_cv_error"] <= by_scope["utc"]["p_less_than_reference"] + 0.01
 
 
 def test_recommend_is_unsure_when_the_scope_does_not_matter():
