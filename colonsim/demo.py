@@ -73,8 +73,8 @@ def insertion_step(material: Path, element_size: float, out: Path, show: bool):
     import numba
 
     # One thread: on a 2-core machine with anything else running, two Numba threads wait on each
-    # other and a run takes up to 8x longer (measured: 147 s instead of 17 s); alone, 1 thread
-    # costs about 1.5x.
+    # other and a run takes up to 8x longer (measured: PDC 147 s instead of 17 s). `colonsim
+    # insert --threads 2` is the faster choice on an idle machine.
     numba.set_num_threads(1)
     cases = [InsertionCase(segment="rsj", scope=s, diameter_mm=36.0, material=str(material),
                            element_size_mm=element_size) for s in ("utc", "pdc", "sdc")]
