@@ -30,8 +30,9 @@ STANDARD = "sdc"
 FRICTIONS = (0.0, 0.05, 0.1)
 RSJ_DIAMETERS = (23.0, 36.0)
 ANGLES = (0.0, 30.0, 45.0)
-# Below this the standard scope barely deforms the colon (0.1 mm): no relative advantage can be read.
-NO_DEFORMATION_CM = 0.01
+# Below this the standard scope barely deforms the colon: no relative advantage can be read from
+# it. 1 mm is a third of the 3 mm wall mesh (SPEC.md 2.1); the source's deformations are 1.3 cm and up.
+NO_DEFORMATION_CM = 0.1
 
 
 @dataclass
@@ -186,9 +187,12 @@ def sc_less_friction_sensitive(table, diameters=RSJ_DIAMETERS, low=0.0, high=0.1
 
 
 def advantage(standard, small, floor=NO_DEFORMATION_CM):
-    """Relative reduction (SDC - SC) / SDC; 0 where the standard scope deforms the colon by less
-    than ``floor`` cm (nothing to reduce)."""
-    return 0.0 if standard < floor else relative_reduction(standard, small)
+    """Relative reduction (SDC - SC) / SDC of the small scope; 0 where neither scope deforms the
+    colon by ``floor`` cm (nothing measurable to reduce), and (SDC - SC) / ``floor`` where only the
+    small scope does (a negative advantage not blown up by a near-zero SDC)."""
+    if max(standard, small) < floor:
+        return 0.0
+    return (standard - small) / max(standard, floor)
 
 
 def angle_dependence(table, segment, angles=ANGLES, friction=0.0, little=0.10, large=0.20,
@@ -207,8 +211,8 @@ def angle_dependence(table, segment, angles=ANGLES, friction=0.0, little=0.10, l
         f"angle_dependence_{segment}",
         f"{segment.upper()}: the advantage of small-caliber scopes depends on {symbol}: small angles (male-like) "
         "show little or no advantage, large angles (female-like) a large one.",
-        f"Advantage a = (SDC - SC) / SDC of {quantity} at mu = {friction:g} (a = 0 where SDC deforms the colon by "
-        f"less than {NO_DEFORMATION_CM:g} cm). For each SC scope (UTC, PDC): (i) a does not decrease with {symbol} over "
+        f"Advantage a = (SDC - SC) / SDC of {quantity} at mu = {friction:g} (a = 0 where both scopes deform the colon by "
+        f"less than {NO_DEFORMATION_CM:g} cm: nothing measurable to reduce). For each SC scope (UTC, PDC): (i) a does not decrease with {symbol} over "
         f"{_list(angles, ' deg')}; (ii) a({symbol} = {lo:g}) < {little:.0%} (little or none); "
         f"(iii) a({symbol} = {hi:g}) >= {large:.0%} (large).", NOT_EVALUATED)
     failures = []

@@ -135,6 +135,11 @@ def test_the_source_numbers_reproduce_the_source_claims_at_mu_0():
     ({"sdc": (1.0, 2.0, 4.0), "pdc": (1.0, 1.8, 3.0), "utc": (0.98, 1.5, 2.0)}, REPRODUCED, ""),
     # straight sigmoid: nobody deforms it (advantage taken as 0), then a growing advantage
     ({"sdc": (1e-14, 2.0, 4.0), "pdc": (1e-14, 1.8, 3.0), "utc": (1e-14, 1.5, 2.0)}, REPRODUCED, ""),
+    # sub-millimetre deformations at 0 deg: no measurable advantage, whatever their ratio
+    ({"sdc": (0.06, 2.0, 4.0), "pdc": (0.01, 1.8, 3.0), "utc": (0.0, 1.5, 2.0)}, REPRODUCED, ""),
+    # nothing measurable at any angle: no large advantage at 45 deg
+    ({"sdc": (0.06, 5e-8, 5e-8), "pdc": (0.01, 5e-8, 5e-8), "utc": (0.0, 1e-3, 3e-4)}, NOT_REPRODUCED,
+     "UTC: advantage 0% at beta = 45 is below 20%"),
     # the same advantage at every angle: a large one already at 0 deg
     ({"sdc": (2.0, 3.0, 4.0), "pdc": (1.4, 2.1, 2.8), "utc": (1.0, 1.5, 2.0)}, NOT_REPRODUCED,
      "PDC: advantage 30% at beta = 0 is not below 10%"),
@@ -153,3 +158,12 @@ def test_two_runs_of_one_case_are_an_error():
     t = rsj_table()
     with pytest.raises(ColonsimError, match="2 successful runs of RSJ SDC D 23 mm, mu 0"):
         sc_deform_less_rsj(pd.concat([t, t[(t["scope"] == "sdc") & (t["diameter_mm"] == 23) & (t["friction"] == 0)]]))
+
+
+def test_advantage_floor():
+    from insertion.claims import NO_DEFORMATION_CM, advantage
+
+    assert advantage(4.0, 3.0) == pytest.approx(0.25)
+    assert advantage(0.5 * NO_DEFORMATION_CM, 0.0) == 0.0  # nothing measurable
+    # only the small scope deforms the colon: negative, scaled by the floor
+    assert advantage(0.0, 2.0 * NO_DEFORMATION_CM) == pytest.approx(-2.0)
