@@ -361,11 +361,36 @@ def rsj_comparison(table, folder, out):
     return rows
 
 
-def segment_overview(table) -> dict:
+def _phases(folder, rows):
+    """Depth at the end of the straightening phase (lateral constraint on the mobile part), the
+    depth pushed, and the largest deformation with the constraint on and after it, per run (cm)."""
+    out = []
+    for _, r in rows.iterrows():
+        path = folder / str(r["timeseries_path"])
+        if not path.is_file():
+            continue
+        ts = pd.read_csv(path, usecols=["phase", "depth_cm", "deformation_cm"])
+        held = ts["phase"] == "straighten"
+        if not held.any():
+            continue
+        after = ts.loc[~held, "deformation_cm"]
+        out.append({"release_depth_cm": float(ts.loc[held, "depth_cm"].max()), "pushed_cm": float(ts["depth_cm"].max()),
+                    "max_held_cm": float(ts.loc[held, "deformation_cm"].max()),
+                    "max_after_cm": float(after.max()) if len(after) else math.nan})
+    return out
+
+
+def segment_overview(table, folder) -> dict:
     """Per colon model: how much its successful runs deform the colon and load the scope."""
     out = {}
     for segment, rows in table[table["status"] == "ok"].groupby("segment"):
-        out[segment] = {"runs": int(len(rows)),
+        phases = _phases(folder, rows)
+        if phases:
+            f = pd.DataFrame(phases)
+            phases = {"release_depth_cm": [float(f["release_depth_cm"].min()), float(f["release_depth_cm"].max())],
+                      "pushed_cm": [float(f["pushed_cm"].min()), float(f["pushed_cm"].max())],
+                      "max_held_cm": float(f["max_held_cm"].max()), "max_after_cm": float(f["max_after_cm"].max())}
+        out[segment] = {"runs": int(len(rows)), "straightening": phases or None,
                         "final_deformation_cm": [float(rows["final_deformation_cm"].min()), float(rows["final_deformation_cm"].max())],
                         "max_deformation_cm": float(rows["max_deformation_cm"].max()),
                         "peak_contact_force_N": [float(rows["peak_contact_force_N"].min()), float(rows["peak_contact_force_N"].max())],
@@ -538,7 +563,12 @@ def write_markdown(doc, path):
                       f"deformation of {num(span['final_deformation_cm'][0])} to {num(span['final_deformation_cm'][1])} cm "
                       f"(largest during any run {num(span['max_deformation_cm'])} cm), with peak contact forces of "
                       f"{num(span['peak_contact_force_N'][0])} to {num(span['peak_contact_force_N'][1])} N and a largest "
-                      f"wall stretch of {num(span['max_wall_stretch'])}.", ""]
+                      f"wall stretch of {num(span['max_wall_stretch'])}."
+                      + (f" The mobile part's lateral motion is held (straightening phase, SPEC.md 2.3) until an "
+                         f"insertion depth of {num(st['release_depth_cm'][0], 3)} to {num(st['release_depth_cm'][1], 3)} cm "
+                         f"of the {num(st['pushed_cm'][0], 3)} to {num(st['pushed_cm'][1], 3)} cm pushed; the largest "
+                         f"deformation is {num(st['max_held_cm'])} cm while held and {num(st['max_after_cm'])} cm after "
+                         "the release." if (st := span.get("straightening")) else ""), ""]
 
     lines += ["## 5. Run times", "",
               "Wall time of each run as recorded in the sweep table (one Numba thread per run; runs of a sweep "
@@ -602,7 +632,7 @@ def main(argv=None):
 
     claims = [c.to_dict() for c in evaluate_claims(table)]
     doc = {"header": header(args, started, expected, table), "verification": verification, "calibration": calibration,
-           "rsj": rsj_comparison(table, args.sweep, out), "claims": claims, "segments": segment_overview(table),
+           "rsj": rsj_comparison(table, args.sweep, out), "claims": claims, "segments": segment_overview(table, args.sweep),
            "run_times": run_times(table),
            "figures": figures}
     doc["timings"] = {"verification_s": t_verification, "calibration_s": t_calibration,
