@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import argparse
 import datetime
+import json
 import math
 import os
 import platform
@@ -286,8 +287,6 @@ def read_sweep(folder: Path):
         path = folder / str(row.get("timeseries_path") or "")
         summary = path.parent / "summary.json"
         if row["status"] == "ok" and summary.is_file():
-            import json
-
             ended.append(json.loads(summary.read_text()).get("ended_by", ""))
         else:
             ended.append("")
@@ -295,8 +294,6 @@ def read_sweep(folder: Path):
     expected = None
     spec = folder / "sweep.json"
     if spec.is_file():
-        import json
-
         expected = len(json.loads(spec.read_text()).get("keys", []))
     return table, expected
 
@@ -338,8 +335,6 @@ def rsj_comparison(table, folder, out):
                     ax.plot(ts["depth_cm"], ts["deformation_cm"], c=colour, lw=1.4, label=f"{scope.upper()} (this model)")
                     summary = ts_path.parent / "summary.json"
                     if summary.is_file():
-                        import json
-
                         points = json.loads(summary.read_text()).get("points_cm") or {}
                         for name, p in points.items():
                             if p:
