@@ -1,65 +1,32 @@
 """Rod resting on a wall: penetration F / k, energy balance, broad phase against all pairs."""
 
-import math
-
 import numpy as np
 import pytest
 
 from insertion.contact import RodShellContact
 from insertion.material import REFERENCE_MATERIAL_PATH, load_material
 from insertion.rod import Rod
-from insertion.sheet_mesh import flat_sheet, straight_tube
+from insertion.sheet_mesh import straight_tube
 from insertion.shell import Shell
-from insertion.solver import ExplicitSolver, FixedNodes, LineConstraint, NodalLoad
+from insertion.verification import SCOPE_D, SCOPE_E, SCOPE_RHO, WALL_T, rod_on_sheet, rod_resting_on_wall, tip_on_node
 
-E = 16e6
-RHO = 2944.0
-D = 12.8e-3
-T = 2e-3  # wall thickness
-
-
-def rod_on_sheet(friction=0.0):
-    """A fixed flat wall (rigid support) and a rod lying along one row of its nodes.
-
-    The row has nodes every 5 mm along x; the rod spans x in [22.5, 77.5] mm, so exactly the 11
-    row nodes at 25..75 mm lie under it (the neighbour rows are 4.4 mm aside, 1.2 mm clear of
-    the capsule, and the row nodes beyond the rod ends 0.4 mm clear of the end caps).
-    """
-    nodes, tri = flat_sheet(0.1, 0.04, 5e-3)
-    wall = Shell(nodes, tri, T, load_material(REFERENCE_MATERIAL_PATH), name="wall")
-    y_row = 0.04 * 4 / 9
-    under = np.flatnonzero((np.abs(nodes[:, 1] - y_row) < 1e-9) & (nodes[:, 0] > 0.0225) & (nodes[:, 0] < 0.0775))
-    z = 0.5 * D + 0.5 * T
-    rod = Rod.straight(0.055, D, E, RHO, spacing=5e-3, start=(0.0225, y_row, z))
-    contact = RodShellContact(rod, wall, damping_ratio=1.0, friction=friction)
-    return wall, rod, contact, under
+E, RHO, D, T = SCOPE_E, SCOPE_RHO, SCOPE_D, WALL_T
 
 
 def test_rod_resting_on_wall_penetrates_f_over_k():
     # A load F spread over the rod like its weight, 11 contact springs k in parallel: at rest
     # the mean penetration is F / (11 k) exactly (vertical force balance). Tolerance 0.5 %: the
     # relaxation residual (contact springs critically damped, 30 time constants); measured 2e-10.
-    wall, rod, contact, under = rod_on_sheet()
     F = 1.0
-    per_node = F * rod.mass / rod.mass.sum()
-    load = NodalLoad(rod, np.arange(rod.n_nodes), np.column_stack((0 * per_node, 0 * per_node, -per_node)))
-    sim = ExplicitSolver([rod, wall], contacts=[contact], constraints=[FixedNodes(wall, np.arange(wall.n_nodes))],
-                         loads=[load], damping={"scope": 0.0})
-    omega = math.sqrt(len(under) * contact.held_stiffness / rod.mass.sum())
-    hist = sim.run(30.0 / omega, record_interval=1.0 / omega)
-    assert contact.n_active == len(under) == 11
-    xr = sim.state["scope"].x
-    pen = 0.5 * D + 0.5 * T - (xr[:, 2].mean())
-    expected = F / (len(under) * contact.held_stiffness)
-    assert pen == pytest.approx(expected, rel=0.005)
-    assert contact.normal_force == pytest.approx(F, rel=0.005)
-    assert contact.force_on_rod[2] == pytest.approx(F, rel=0.005)
+    r = rod_resting_on_wall(F)
+    assert r.n_active == r.n_under == 11
+    assert r.penetration.measured == pytest.approx(r.penetration.analytic, rel=0.005)
+    assert r.normal_force == pytest.approx(F, rel=0.005)
+    assert r.force_on_rod_z == pytest.approx(F, rel=0.005)
     # energy: kinetic + strain + contact penalty + dissipated - work of the load is conserved
     # to 2 % of the work (the contact damping power is evaluated at the half-step velocity)
-    balance = hist.total_energy_balance()
-    work = hist.bodies["scope"]["external_work"][-1]
-    assert np.max(np.abs(balance)) < 0.02 * work
-    assert hist.contacts[0]["energy"][-1] == pytest.approx(0.5 * F * expected, rel=0.01)
+    assert r.energy_residual < 0.02 * r.work
+    assert r.contact_energy == pytest.approx(0.5 * F * r.penetration.analytic, rel=0.01)
 
 
 def test_broad_phase_finds_every_contact_of_all_pairs():
@@ -126,21 +93,6 @@ def test_hemispherical_tip_pressed_on_a_node_penetrates_f_over_k():
     # its whole length) and pushed with F: only the node under the tip touches (its neighbours,
     # 5 mm aside, are 1.5 mm clear of the 7.4 mm sphere), so the tip sinks F / k into it.
     # Tolerance 0.5 %: relaxation residual of the critically damped contact spring.
-    nodes, tri = flat_sheet(0.1, 0.04, 5e-3)
-    wall = Shell(nodes, tri, T, load_material(REFERENCE_MATERIAL_PATH), name="wall")
-    below = int(np.argmin(np.hypot(nodes[:, 0] - 0.05, nodes[:, 1] - 0.04 * 4 / 9)))
-    reach = 0.5 * D + 0.5 * T
-    top = nodes[below] + (0.0, 0.0, reach + 0.03)
-    rod = Rod.straight(0.03, D, E, RHO, spacing=5e-3, start=top, direction=(0.0, 0.0, -1.0))
-    contact = RodShellContact(rod, wall, damping_ratio=1.0)
-    F = 0.2
-    sim = ExplicitSolver(
-        [rod, wall], contacts=[contact],
-        constraints=[FixedNodes(wall, np.arange(wall.n_nodes)), LineConstraint(rod, top, (0.0, 0.0, -1.0))],
-        loads=[NodalLoad(rod, [0], (0.0, 0.0, -F))],
-    )
-    omega = math.sqrt(contact.held_stiffness / rod.mass.sum())
-    sim.run(30.0 / omega, record_interval=1.0 / omega)
-    assert contact.n_active == 1
-    tip = sim.state["scope"].x[rod.tip_node]
-    assert reach - (tip[2] - nodes[below, 2]) == pytest.approx(F / contact.held_stiffness, rel=0.005)
+    penetration, n_active = tip_on_node(0.2)
+    assert n_active == 1
+    assert penetration.measured == pytest.approx(penetration.analytic, rel=0.005)

@@ -1,6 +1,6 @@
 """Hinge bending of the shell against plate theory.
 
-A flat near-equilateral sheet is mapped isometrically onto a cylinder of radius R; the hinge
+A flat near-equilateral sheet (built, with the maps, in :mod:`insertion.verification`) is mapped isometrically onto a cylinder of radius R; the hinge
 energy per unit area of the sheet's interior must be the plate value D / (2 R^2) with
 D = E0 t^3 / 9 (nu = 1/2), whatever the cylinder's direction relative to the mesh.
 """
@@ -8,13 +8,13 @@ D = E0 t^3 / 9 (nu = 1/2), whatever the cylinder's direction relative to the mes
 import numpy as np
 import pytest
 
-from insertion.material import REFERENCE_MATERIAL_PATH, load_material
-from insertion.sheet_mesh import flat_sheet, straight_tube
-from insertion.shell import Shell, dihedral_angles
+from insertion.sheet_mesh import straight_tube
+from insertion.shell import Shell
+from insertion.verification import (WALL_T, bending_sheet, cylinder_bending, onto_cylinder,
+                                    reference_material, sphere_bending)
 
-MATERIAL = load_material(REFERENCE_MATERIAL_PATH)
-THICKNESS = 0.002
-SIDE, H = 0.06, 0.003  # 516 nodes; the interior (2 h from the edges) holds ~900 hinges
+MATERIAL = reference_material()
+THICKNESS = WALL_T
 
 
 def _bending(shell, x):
@@ -22,45 +22,8 @@ def _bending(shell, x):
     return shell.bending_forces(x, f), f
 
 
-def _interior_energy_density(shell, x):
-    """Hinge energy per unit area away from the sheet's edges, J/m^2.
-
-    Each hinge stands for (A_1 + A_2)/3 of area. A rectangular window cuts the three edge
-    directions of the mesh unequally (a few percent at this size), and for a cylinder the hinge
-    angle depends on the edge direction, so the density is summed per direction class
-    (mean energy of the class over the mean hinge area), which is what an unbounded mesh gives.
-    """
-    nodes, hinge = shell.x0, shell.hinges
-    edge = nodes[hinge[:, 1]] - nodes[hinge[:, 0]]
-    area_pair = 0.5 * (
-        np.linalg.norm(np.cross(edge, nodes[hinge[:, 2]] - nodes[hinge[:, 0]]), axis=1)
-        + np.linalg.norm(np.cross(nodes[hinge[:, 3]] - nodes[hinge[:, 0]], edge), axis=1)
-    )
-    direction = np.round(np.degrees(np.arctan2(edge[:, 1], edge[:, 0])) % 180.0 / 60.0).astype(int) % 3
-    centre = nodes[hinge].mean(axis=1)
-    inside = np.all((centre[:, :2] > 2 * H) & (centre[:, :2] < SIDE - 2 * H), axis=1)
-    energy = shell.hinge_stiffness * dihedral_angles(x, hinge) ** 2
-    return sum(energy[inside & (direction == k)].mean() for k in range(3)) / area_pair[inside].mean()
-
-
-def _sheet():
-    nodes, tri = flat_sheet(SIDE, SIDE, H)
-    return Shell(nodes, tri, THICKNESS, MATERIAL)
-
-
-def _onto_cylinder(nodes, radius, angle):
-    """Isometric map of the z = 0 sheet onto a cylinder whose axis makes ``angle`` with x."""
-    axis = np.array([np.cos(angle), np.sin(angle), 0.0])
-    across = np.array([-np.sin(angle), np.cos(angle), 0.0])
-    p = nodes - [SIDE / 2, SIDE / 2, 0.0]
-    s, a = p @ across, p @ axis
-    x = a[:, None] * axis + (radius * np.sin(s / radius))[:, None] * across
-    x[:, 2] = radius * (1.0 - np.cos(s / radius))
-    return np.ascontiguousarray(x)
-
-
 def test_bending_stiffness_is_plate_value():
-    assert _sheet().bending_stiffness == pytest.approx(MATERIAL.E0 * THICKNESS**3 / (12 * (1 - 0.25)), rel=1e-12)
+    assert bending_sheet().bending_stiffness == pytest.approx(MATERIAL.E0 * THICKNESS**3 / (12 * (1 - 0.25)), rel=1e-12)
 
 
 @pytest.mark.parametrize("angle_deg", [0, 15, 30, 45, 60, 90])
@@ -73,16 +36,14 @@ def test_cylindrical_bending_energy_matches_plate_theory(angle_deg, radius):
     rows being spaced 0.4 % off the equilateral value (rounding of the row count) and from
     O((h/R)^2) = 1 % at R = 3 cm, whose effect on the angle-squared sum is far smaller.
     """
-    shell = _sheet()
-    x = _onto_cylinder(shell.x0, radius, np.radians(angle_deg))
-    density = _interior_energy_density(shell, x)
-    assert density == pytest.approx(shell.bending_stiffness / (2.0 * radius**2), rel=1e-2)
+    c = cylinder_bending(radius, angle_deg)
+    assert c.measured == pytest.approx(c.analytic, rel=1e-2)
 
 
 def test_whole_sheet_cylinder_energy():
     """The total hinge energy of the whole sheet, edges included, over the hinge area is the plate
     value within 3 % (measured <= 2.8 % for h/side = 1/20: boundary rows, O(h / side))."""
-    shell = _sheet()
+    shell = bending_sheet()
     nodes, hinge = shell.x0, shell.hinges
     edge = nodes[hinge[:, 1]] - nodes[hinge[:, 0]]
     hinge_area = (
@@ -91,21 +52,15 @@ def test_whole_sheet_cylinder_energy():
     ).sum() / 6.0
     radius = 0.05
     for angle in np.radians([0, 30, 45, 90]):
-        energy, _ = _bending(shell, _onto_cylinder(nodes, radius, angle))
+        energy, _ = _bending(shell, onto_cylinder(nodes, radius, angle))
         assert energy == pytest.approx(shell.bending_stiffness / (2 * radius**2) * hinge_area, rel=3e-2)
 
 
 def test_spherical_bending_shows_documented_hinge_poisson_ratio():
     """A shallow spherical cap (R = 0.3 m) gives the hinge model's own value (2/3) D / R^2 per area
     (intrinsic Poisson ratio -1/3, documented in insertion/shell.py) within 1 %; measured 0.1 %."""
-    shell = _sheet()
-    radius = 0.3
-    p = shell.x0 - [SIDE / 2, SIDE / 2, 0.0]
-    rho = np.hypot(p[:, 0], p[:, 1])
-    scale = np.where(rho > 0, radius * np.sin(rho / radius) / np.where(rho > 0, rho, 1.0), 1.0)
-    x = np.ascontiguousarray(np.column_stack((p[:, 0] * scale, p[:, 1] * scale, radius * (1 - np.cos(rho / radius)))))
-    density = _interior_energy_density(shell, x)
-    assert density == pytest.approx(2.0 / 3.0 * shell.bending_stiffness / radius**2, rel=1e-2)
+    c = sphere_bending(0.3)
+    assert c.measured == pytest.approx(c.analytic, rel=1e-2)
 
 
 def test_hinge_forces_are_minus_energy_gradient(serial_kernels, energy_gradient):

@@ -7,11 +7,11 @@ from colonsim.errors import ColonsimError
 from identification.laws import get_law
 from identification.membrane import membrane_stress
 from identification.specimen import ClampedStripModel, FEConvergenceError
-from identification.uniaxial import homogeneous_force, nominal_stress
+from identification.verification import (DISPLACEMENTS, REFERENCE, STRIP, membrane_uniaxial_stress, mesh_convergence,
+                                         specimen_against_closed_form)
 
-REFERENCE = np.array([652.01, 42835.25, 219120.3])
-L, W, T = 0.1, 0.025, 0.002
-D = np.linspace(3e-3, 60e-3, 6)  # up to 60 % strain, the end of the test
+L, W, T = STRIP
+D = DISPLACEMENTS  # up to 60 % strain, the end of the test
 
 
 @pytest.mark.parametrize("law,params", [("mooney_rivlin_3", REFERENCE), ("yeoh", (1e4, 5e4, 2e4))])
@@ -29,34 +29,28 @@ def test_membrane_tangent_matches_finite_differences(law, params):
 
 
 def test_membrane_uniaxial_state_matches_closed_form():
-    lam = np.linspace(1.05, 1.6, 8)
-    F = np.zeros((lam.size, 4))
-    F[:, 0], F[:, 3] = lam, lam**-0.5  # free lateral contraction of an incompressible sheet
-    P = membrane_stress(F, get_law("mooney_rivlin_3"), REFERENCE, tangent=False)
-    np.testing.assert_allclose(P[:, 0], nominal_stress(lam, get_law("mooney_rivlin_3"), REFERENCE), rtol=1e-12)
-    np.testing.assert_allclose(P[:, 3], 0.0, atol=1e-9 * P[:, 0].max())  # no lateral stress
+    axial, closed_form, lateral = membrane_uniaxial_stress(np.linspace(1.05, 1.6, 8))  # free lateral contraction
+    np.testing.assert_allclose(axial, closed_form, rtol=1e-12)
+    np.testing.assert_allclose(lateral, 0.0, atol=1e-9 * axial.max())  # no lateral stress
 
 
 def test_sliding_grips_equal_the_closed_form():
     """Without the clamp the strip is homogeneous: any mesh reproduces the closed form exactly
     (constant F is in the P2 space), so the 0.5 % of the issue is a loose bound."""
-    f = ClampedStripModel(L, W, T, grips="sliding").solve(REFERENCE, D)
-    exact = homogeneous_force(D, L, W, T, get_law("mooney_rivlin_3"), REFERENCE)
-    np.testing.assert_allclose(f, exact, rtol=5e-3)
+    c = specimen_against_closed_form("sliding")
+    np.testing.assert_allclose(c.model, c.closed_form, rtol=5e-3)
 
 
 def test_clamped_grips_are_stiffer_by_a_few_percent():
     """SPEC.md 1.3: the clamp blocks lateral contraction near the grips, 2-3 % for this geometry."""
-    f = ClampedStripModel(L, W, T).solve(REFERENCE, D)
-    excess = f / homogeneous_force(D, L, W, T, get_law("mooney_rivlin_3"), REFERENCE) - 1.0
+    excess = specimen_against_closed_form("clamped").relative_difference
     assert np.all(excess > 0.01) and np.all(excess < 0.05), excess
 
 
 def test_default_mesh_is_converged_to_half_a_percent():
     """8 x 3 P2 (the calibration default) against a 4x finer mesh at the most strained point."""
-    coarse = ClampedStripModel(L, W, T).solve(REFERENCE, D[-1:])
-    fine = ClampedStripModel(L, W, T, n_length=24, n_width=9).solve(REFERENCE, D[-1:])
-    assert coarse[0] == pytest.approx(fine[0], rel=5e-3)
+    coarse, fine = mesh_convergence(D[-1], fine=(24, 9))
+    assert coarse == pytest.approx(fine, rel=5e-3)
 
 
 def test_force_at_each_displacement_independent_of_sampling():

@@ -1,0 +1,125 @@
+"""Verification of the calibration chain: the specimen model against the closed form of
+homogeneous uniaxial tension, its mesh convergence, and recovery of the known parameters of the
+bundled synthetic specimens (``data/tensile/ground_truth.json``).
+
+The test-suite (``tests/test_specimen.py``, ``tests/test_calibration.py``) asserts on these
+numbers and ``benchmarks/validation_report.py`` tabulates them. Forces in N, lengths in m,
+parameters in Pa.
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from identification.laws import get_law
+from identification.membrane import membrane_stress
+from identification.pipeline import Budget, CalibrationResult
+from identification.population import calibrate_curve
+from identification.specimen import ClampedStripModel
+from identification.testdata import TensileCurve, read_manifest
+from identification.uniaxial import homogeneous_force, nominal_stress
+
+# SPEC.md 1.5: the source's identified parameters (C10, C01, C11), Pa.
+REFERENCE = np.array([652.01, 42835.25, 219120.3])
+# SPEC.md 1.1: free length and width of the source's strips, m; thickness 2 mm (an assumption).
+STRIP = (0.1, 0.025, 0.002)
+DISPLACEMENTS = np.linspace(3e-3, 60e-3, 6)  # up to 60 % strain, the end of the test
+DATA = Path(__file__).resolve().parents[1] / "data" / "tensile"
+NAMES = ("C10", "C01", "C11")
+
+
+@dataclass
+class ForceCurve:
+    """Force of a specimen model and of the homogeneous closed form at the same displacements."""
+
+    displacement: np.ndarray  # m
+    model: np.ndarray  # N
+    closed_form: np.ndarray  # N
+
+    @property
+    def relative_difference(self) -> np.ndarray:
+        return self.model / self.closed_form - 1.0
+
+
+def specimen_against_closed_form(grips, params=REFERENCE, displacements=DISPLACEMENTS, strip=STRIP,
+                                 law="mooney_rivlin_3") -> ForceCurve:
+    """The FE strip with ``grips`` ("sliding": homogeneous, must equal the closed form;
+    "clamped": the real test, a few percent stiffer) against :func:`homogeneous_force`."""
+    length, width, thickness = strip
+    d = np.asarray(displacements, dtype=float)
+    fe = ClampedStripModel(length, width, thickness, law=law, grips=grips).solve(params, d)
+    return ForceCurve(d, fe, homogeneous_force(d, length, width, thickness, get_law(law), params))
+
+
+def membrane_uniaxial_stress(stretches, params=REFERENCE, law="mooney_rivlin_3"):
+    """The plane-stress membrane law at F = diag(l, l^-1/2) against SPEC.md 1.2's closed form.
+
+    Returns (axial nominal stress of the membrane, closed form, lateral stress of the membrane), Pa.
+    """
+    lam = np.asarray(stretches, dtype=float)
+    F = np.zeros((lam.size, 4))
+    F[:, 0], F[:, 3] = lam, lam**-0.5  # free lateral contraction of an incompressible sheet
+    P = membrane_stress(F, get_law(law), params, tangent=False)
+    return P[:, 0], nominal_stress(lam, get_law(law), params), P[:, 3]
+
+
+def mesh_convergence(displacement=DISPLACEMENTS[-1], params=REFERENCE, strip=STRIP, fine=(24, 9)):
+    """Force of the default 8 x 3 P2 mesh and of a finer one at ``displacement``; returns
+    (default, fine), N."""
+    length, width, thickness = strip
+    coarse = ClampedStripModel(length, width, thickness).solve(params, [displacement])[0]
+    finer = ClampedStripModel(length, width, thickness, n_length=fine[0], n_width=fine[1]).solve(params, [displacement])[0]
+    return float(coarse), float(finer)
+
+
+def ground_truth(data=DATA) -> dict:
+    return json.loads((Path(data) / "ground_truth.json").read_text())
+
+
+@dataclass
+class SpecimenRecovery:
+    """A calibration of one bundled synthetic specimen next to the parameters that generated it."""
+
+    curve: TensileCurve
+    result: CalibrationResult
+    truth: np.ndarray  # generating parameters, Pa
+    noise_sd: float  # load-cell noise put into the data, N
+
+    @property
+    def mu0(self) -> tuple[float, float, float]:
+        """Small-strain shear modulus 2 (C10 + C01): identified, its standard deviation, true; Pa."""
+        p = self.result.parameters
+        sd = 2.0 * self.result.uncertainty.linear_combination_std([1.0, 1.0, 0.0])
+        return 2.0 * (p[0] + p[1]), sd, 2.0 * (self.truth[0] + self.truth[1])
+
+    @property
+    def truth_in_region(self) -> bool:
+        """Whether the generating parameters lie in the fit's 95 % joint confidence region."""
+        return self.result.uncertainty.contains(self.truth)
+
+    def table(self) -> list[dict]:
+        """One row per parameter and for mu0: identified, sd, 95 % interval, true, error."""
+        unc = self.result.uncertainty
+        ci = unc.interval(0.95)
+        rows = [{"parameter": n, "identified_Pa": float(v), "sd_Pa": float(s), "ci95_Pa": ci[i].tolist(),
+                 "true_Pa": float(t), "error_in_sd": float((v - t) / s) if s > 0 else float("nan")}
+                for i, (n, v, s, t) in enumerate(zip(self.result.names, self.result.parameters, unc.std, self.truth))]
+        mu0, sd, true = self.mu0
+        rows.append({"parameter": "mu0 = 2 (C10 + C01)", "identified_Pa": mu0, "sd_Pa": sd,
+                     "ci95_Pa": [mu0 - 1.96 * sd, mu0 + 1.96 * sd], "true_Pa": true,
+                     "error_in_sd": (mu0 - true) / sd if sd > 0 else float("nan")})
+        return rows
+
+
+def specimen_recovery(specimen="specimen_01", budget: Budget | None = None, seed=1, data=DATA) -> SpecimenRecovery:
+    """Calibrate the bundled ``specimen`` with the FE pipeline (SPEC.md 1.5) at ``budget``."""
+    truth_doc = ground_truth(data)
+    curves = {c.name: c for c in read_manifest(Path(data) / "manifest.csv")}
+    curve = curves[specimen]
+    truth = np.array([truth_doc["specimens"][specimen]["parameters_Pa"][n] for n in NAMES])
+    result = calibrate_curve(curve, budget=budget or Budget(), seed=seed)
+    return SpecimenRecovery(curve, result, truth, float(truth_doc["noise_sd_N"]))

@@ -1,0 +1,33 @@
+"""The source's reference numbers (SPEC.md 2.5: LS-DYNA results of the source's Chapter V).
+
+Constants copied from SPEC.md 2.5; nothing here is computed by this project.
+"""
+
+from __future__ import annotations
+
+import pandas as pd
+
+# SPEC.md 2.5: RSJ colon deformation (cm) at points A and C, mu = 0, per (scope, colon diameter mm).
+# The source's final deformation equals the value at C (SPEC.md 2.4).
+SOURCE_RSJ_CM = {
+    ("utc", 23.0): {"A": 1.353, "C": 2.575},
+    ("utc", 36.0): {"A": 1.319, "C": 2.389},
+    ("pdc", 23.0): {"A": 2.155, "C": 3.384},
+    ("pdc", 36.0): {"A": 1.992, "C": 3.077},
+    ("sdc", 23.0): {"A": 3.218, "C": 4.234},
+    ("sdc", 36.0): {"A": 2.651, "C": 3.824},
+}
+
+# SPEC.md 2.5: run time of one insertion, minutes (LS-DYNA 17, 4-core i7-4600U laptop).
+SOURCE_RUN_MINUTES = {
+    ("rsj", "utc"): 50, ("rsj", "pdc"): 78, ("rsj", "sdc"): 100,
+    ("rsf", "utc"): 150, ("rsf", "pdc"): 240, ("rsf", "sdc"): 380,
+    ("thf", "utc"): 100, ("thf", "pdc"): 180, ("thf", "sdc"): 140,
+}
+
+
+def source_rsj_table() -> pd.DataFrame:
+    """The source's RSJ numbers as rows of a sweep results table (``status`` ok, mu = 0)."""
+    return pd.DataFrame([{"segment": "rsj", "scope": scope, "diameter_mm": d, "friction": 0.0, "angle_deg": 0.0,
+                          "point_A_cm": v["A"], "point_C_cm": v["C"], "final_deformation_cm": v["C"], "status": "ok"}
+                         for (scope, d), v in SOURCE_RSJ_CM.items()])
