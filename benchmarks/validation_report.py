@@ -556,9 +556,17 @@ def write_markdown(doc, path):
               "or failed; nothing is inferred from the runs present. Deformations in cm; reductions and advantages "
               "are fractions of the SDC's deformation. Runs that ended on the push-depth cap (section 3) give a "
               "lower bound of the deformation that passing the fixed end would need.", ""]
+    def tally(cl):
+        rows = [e for e in cl["evidence"] if "holds" in e]
+        return f"{sum(e['holds'] is True for e in rows)} of {len(rows)}" if rows else "-"
+
+    lines += ["| claim | verdict | comparisons that hold |", "|---|---|---|"]
+    lines += [f"| 4.{k} {cl['statement']} | {cl['verdict']} | {tally(cl)} |" for k, cl in enumerate(doc["claims"], start=1)]
+    lines += [""]
     for k, cl in enumerate(doc["claims"], start=1):
         lines += [f"### 4.{k} {cl['statement']}", "", f"**Criterion.** {cl['criterion']}", "",
-                  f"**Verdict: {cl['verdict']}.**" + (f" {cl['reason']}." if cl["reason"] else ""), ""]
+                  f"**Verdict: {cl['verdict']}** ({tally(cl)} comparisons hold)."
+                  + (f" {cl['reason']}." if cl["reason"] else ""), ""]
         if cl["evidence"]:
             keys = list(dict.fromkeys(k for e in cl["evidence"] for k in e))
             lines += [md_table(cl["evidence"], [(key, key) for key in keys]), ""]

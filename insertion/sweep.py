@@ -182,8 +182,9 @@ class SweepStore:
             if col not in frame:
                 frame[col] = math.nan  # a field added to InsertionCase after older rows were written
         frame = frame[first + [c for c in frame.columns if c not in first]]
-        for col in ("quasi_static", "quasi_static_without_imposed_sliding"):
-            frame[col] = frame[col].fillna(False).astype(bool)
+        frame["quasi_static"] = frame["quasi_static"].fillna(False).astype(bool)
+        # rows written before this column existed: unknown (<NA>), not "failed"
+        frame["quasi_static_without_imposed_sliding"] = frame["quasi_static_without_imposed_sliding"].astype("boolean")
         return frame.reset_index(drop=True)
 
     def write(self):
