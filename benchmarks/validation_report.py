@@ -21,7 +21,6 @@ import math
 import os
 import platform
 import shlex
-import subprocess
 import sys
 import time
 from pathlib import Path
@@ -36,6 +35,7 @@ if str(ROOT) not in sys.path:  # run as a script from a checkout: import this tr
 
 from colonsim.errors import ColonsimError  # noqa: E402
 from colonsim.files import atomic_path, save_figure, write_json  # noqa: E402
+from colonsim.provenance import code_version  # noqa: E402
 from insertion import verification as iv  # noqa: E402
 from insertion.claims import evaluate_claims  # noqa: E402
 from insertion.reference import SOURCE_RSJ_CM, SOURCE_RUN_MINUTES  # noqa: E402
@@ -432,13 +432,9 @@ def run_time_summary(rows):
 # --- the document -------------------------------------------------------------------------------
 
 def header(args, started, expected, table):
-    try:
-        commit = subprocess.run(["git", "-C", str(ROOT), "rev-parse", "HEAD"], capture_output=True, text=True,
-                                check=True).stdout.strip()
-        dirty = subprocess.run(["git", "-C", str(ROOT), "status", "--porcelain", "--untracked-files=no"],
-                               capture_output=True, text=True).stdout.strip()
-    except (OSError, subprocess.CalledProcessError):
-        commit, dirty = "unknown (not a git checkout)", ""
+    # taken when the script started (code_version caches it), before it rewrote its own outputs
+    recorded = code_version()["git_commit"] or "unknown (not a git checkout)"
+    commit, dirty = recorded.removesuffix("+modified"), recorded.endswith("+modified")
     threads = os.environ.get("NUMBA_NUM_THREADS")
     command = ("NUMBA_NUM_THREADS=" + threads + " " if threads else "") + "python " + " ".join(
         shlex.quote(a) for a in [os.path.relpath(sys.argv[0], ROOT) if os.path.isabs(sys.argv[0]) else sys.argv[0], *sys.argv[1:]])
@@ -613,6 +609,7 @@ def _clean(value):
 
 
 def main(argv=None):
+    code_version()  # the commit and whether the tree is clean, before anything is written
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--sweep", type=Path, default=Path("colonsim_results/sweep_thesis"),
                         help="sweep folder with results.parquet and runs/<key>/ (default colonsim_results/sweep_thesis)")
