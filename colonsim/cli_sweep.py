@@ -8,7 +8,7 @@ from pathlib import Path
 from colonsim.errors import ColonsimError
 
 
-def _cores() -> int:
+def available_cores() -> int:
     try:
         return len(os.sched_getaffinity(0))
     except AttributeError:  # pragma: no cover - not Linux
@@ -25,7 +25,7 @@ def add_parser(sub):
     p.add_argument("spec", nargs="?", type=Path, help="sweep TOML file")
     p.add_argument("--preset", help="thesis (the source's 39 insertions) or smoke (3 fast runs)")
     p.add_argument("--workers", type=int, default=None,
-                   help=f"local worker processes, one Numba thread each (default: the cores, {_cores()} here)")
+                   help=f"local worker processes, one Numba thread each (default: the cores, {available_cores()} here)")
     p.add_argument("--scheduler", metavar="ADDR",
                    help="run on a Dask distributed cluster, e.g. tcp://HOST:8786 (workers: dask worker ADDR --nthreads 1)")
     p.add_argument("--out", type=Path, help="output folder (default colonsim_results/sweep_NAME)")
@@ -42,7 +42,7 @@ def cmd_sweep(args):
 
     if args.scheduler is not None and args.workers is not None:
         raise ColonsimError("--workers is for local runs; a Dask cluster (--scheduler) has its own workers")
-    workers = _cores() if args.workers is None else args.workers
+    workers = available_cores() if args.workers is None else args.workers
     if workers < 1:
         raise ColonsimError(f"--workers {workers}; give at least 1")
     spec = load_sweep(args.spec, args.preset)

@@ -13,7 +13,6 @@ run and where each file is. Rerunning into the same folder skips the sweep runs 
 from __future__ import annotations
 
 import argparse
-import os
 import time
 from pathlib import Path
 
@@ -39,13 +38,6 @@ PATIENTS = (
     {"label": "older European patient (diverticular disease)", "age": "older", "region": "european"},
 )
 SURROGATE_TARGETS = ("final_deformation_cm", "point_A_cm", "peak_contact_force_N", "max_wall_stretch")
-
-
-def _cores() -> int:
-    try:
-        return len(os.sched_getaffinity(0))
-    except AttributeError:  # pragma: no cover - not Linux
-        return os.cpu_count() or 1
 
 
 def _section(text):
@@ -209,7 +201,9 @@ def print_summary(calibration, insertions, model, recs):
 def run_demo(args):
     out: Path = args.out
     show = not args.no_progress
-    workers = args.workers or min(2, _cores())
+    from colonsim.cli_sweep import available_cores
+
+    workers = args.workers or min(2, available_cores())
     seconds = {}
     t0 = time.perf_counter()
     calibration = calibrate_step(out / "calibration", show)
