@@ -35,6 +35,7 @@ if str(ROOT) not in sys.path:  # run as a script from a checkout: import this tr
 
 from colonsim.errors import ColonsimError  # noqa: E402
 from colonsim.files import atomic_path, save_figure, write_json  # noqa: E402
+from colonsim.markdown import md_table, num  # noqa: E402
 from colonsim.provenance import code_version  # noqa: E402
 from insertion import verification as iv  # noqa: E402
 from insertion.claims import evaluate_claims  # noqa: E402
@@ -46,35 +47,10 @@ COLOURS = {"utc": "tab:blue", "pdc": "tab:orange", "sdc": "tab:red"}
 
 # --- formatting -----------------------------------------------------------------------------
 
-def num(v, digits=4):
-    """A number for a table: 4 significant digits, '-' for None/NaN."""
-    if v is None or (isinstance(v, float) and not math.isfinite(v)):
-        return "-"
-    if isinstance(v, (bool, np.bool_)):
-        return "yes" if v else "no"
-    if isinstance(v, (int, np.integer)):
-        return str(int(v))
-    if v != 0 and (abs(v) < 1e-3 or abs(v) >= 1e5):
-        return f"{v:.{digits - 1}e}"
-    return f"{v:.{digits}g}"
-
-
 def pct(v, digits=2):
     if v is None or not math.isfinite(v):
         return "-"
     return f"{100 * v:+.{digits}g} %"
-
-
-def md_table(rows, columns):
-    """Markdown table of ``rows`` (dicts); ``columns`` = [(header, key or callable(row))]."""
-    lines = ["| " + " | ".join(h for h, _ in columns) + " |", "|" + "---|" * len(columns)]
-    for r in rows:
-        cells = []
-        for _, key in columns:
-            v = key(r) if callable(key) else r.get(key)
-            cells.append(v if isinstance(v, str) else num(v))
-        lines.append("| " + " | ".join(c.replace("|", "\\|") for c in cells) + " |")
-    return "\n".join(lines)
 
 
 # --- 1. verification ------------------------------------------------------------------------

@@ -131,15 +131,16 @@ def recommend_step(model, out: Path):
     return recs
 
 
-def _markdown_table(frame) -> str:
-    head = "| " + " | ".join(frame.columns) + " |\n|" + "---|" * len(frame.columns) + "\n"
-    fmt = lambda v: f"{v:.3g}" if isinstance(v, float) else str(v)  # noqa: E731
-    return head + "\n".join("| " + " | ".join(fmt(v) for v in row) + " |" for row in frame.itertuples(index=False))
+def _cell(v) -> str:
+    return f"{v:.3g}" if isinstance(v, float) else str(v)
 
 
 def write_report(out: Path, calibration, insertions, sweep, model, recs, seconds: dict, element_size: float):
     """``report.md``: what the demo ran, its main numbers and where each file is."""
+    from colonsim.files import atomic_path
+    from colonsim.markdown import frame_table
     from insertion.results import comparison_table
+    from surrogate.recommend import format_recommendation
 
     sd = dict(zip(calibration.names, calibration.uncertainty.std))
     lines = ["# colonsim demo", "",
@@ -152,26 +153,22 @@ def write_report(out: Path, calibration, insertions, sweep, model, recs, seconds
     lines += ["- fit, sensitivity and objective figures: `calibration/fit.png`, `calibration/sensitivity.png`, "
               "`calibration/objective.png`; parameters and uncertainty: `calibration/material.json`", "",
               "## 2. RSJ insertions, D = 36 mm, mu = 0 (`insertion/`)", "",
-              _markdown_table(comparison_table(insertions)), "",
+              frame_table(comparison_table(insertions), _cell), "",
               "![RSJ insertions](insertion/comparison.png)", "",
               "## 3. Sweep (`sweep/`)", "",
               f"{sweep.total} runs, {int((sweep.table['status'] == 'ok').sum())} ok. "
               "Table: `sweep/results.parquet`; time series: `sweep/runs/<key>/`.", "",
-              _markdown_table(sweep.table.sort_values(["diameter_mm", "friction", "scope_diameter_mm"])[
+              frame_table(sweep.table.sort_values(["diameter_mm", "friction", "scope_diameter_mm"])[
                   ["scope", "diameter_mm", "friction", "point_A_cm", "point_C_cm", "final_deformation_cm",
-                   "peak_contact_force_N"]]), "",
+                   "peak_contact_force_N"]], _cell), "",
               "## 4. Surrogate (`surrogate.json` + `surrogate.npz`)", "", "```", model.report(), "```", "",
               "![surrogate vs colon diameter](surrogate_vs_diameter_mm.png)", "",
               "## 5. Recommendations (`recommendations.json`)", ""]
-    from surrogate.recommend import format_recommendation
-
     for rec in recs:
         lines += [f"**{rec['patient']['label']}** ({rec['patient']['mapping']})", "", "```",
                   format_recommendation(rec), "```", ""]
     lines += ["These numbers come from a 12-run sweep: the surrogate's cross-validation above says how far to "
               "trust them. `colonsim sweep --preset thesis` runs the source's 39 insertions."]
-    from colonsim.files import atomic_path
-
     with atomic_path(out / "report.md") as tmp:
         tmp.write_text("\n".join(lines) + "\n", encoding="utf-8")
     return out / "report.md"

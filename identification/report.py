@@ -30,15 +30,6 @@ MATERIAL_FORMAT = "colonsim-material/1"
 _STAGE_COLOURS = {"initial": "k", "sensitivity": "tab:gray", "cma-es": "tab:blue", "nelder-mead": "tab:red"}
 
 
-def _version():
-    from importlib.metadata import PackageNotFoundError, version
-
-    try:
-        return version("colonsim")
-    except PackageNotFoundError:
-        return "unknown"
-
-
 def material_document(result: CalibrationResult, level=0.95) -> dict:
     """The ``material.json`` document of one calibration (read by :mod:`insertion.material`)."""
     law = get_law(result.model["law"])
@@ -65,7 +56,7 @@ def material_document(result: CalibrationResult, level=0.95) -> dict:
         "specimen": {"name": result.curve.name, "length_mm": result.curve.length * 1e3,
                      "width_mm": result.curve.width * 1e3, "thickness_mm": result.curve.thickness * 1e3,
                      **result.curve.meta},
-        "provenance": {"tool": "colonsim calibrate", "version": _version(), **code_version(),
+        "provenance": {"tool": "colonsim calibrate", **code_version(),
                        "date": _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds"),
                        **result.settings},
     }
