@@ -135,7 +135,7 @@ def max_displacement(x, x_ref):
 
 
 @numba.njit(cache=True, inline="always")  # a call per node would cost more than its work
-def _contact_one(c, xs, vs, ms, fixed_s, xr, vr, mr, seg, nodes, ptr, cand, radius, offset, k_free, k_held, zeta,
+def _contact_one(c, xs, vs, ms, fixed_s, held_n, xr, vr, mr, seg, nodes, ptr, cand, radius, offset, k_free, k_held, zeta,
                  mu, v_slip, dt, fs, rod_seg, rod_t, rod_k, rod_f, damp_f, fric_f):
     """Contact of candidate wall node ``nodes[c]``: (energy, damping power, friction power,
     active 0/1, normal force)."""
@@ -159,9 +159,15 @@ def _contact_one(c, xs, vs, ms, fixed_s, xr, vr, mr, seg, nodes, ptr, cand, radi
     a = seg[best_s, 0]
     b = seg[best_s, 1]
     t = best_t
-    n0 = (xs[i, 0] - ((1.0 - t) * xr[a, 0] + t * xr[b, 0])) / dist
-    n1 = (xs[i, 1] - ((1.0 - t) * xr[a, 1] + t * xr[b, 1])) / dist
-    n2 = (xs[i, 2] - ((1.0 - t) * xr[a, 2] + t * xr[b, 2])) / dist
+    if fixed_s[i] and (held_n[i, 0] != 0.0 or held_n[i, 1] != 0.0 or held_n[i, 2] != 0.0):
+        # a point of the rigid fixed wall: it pushes along that wall's normal at rest
+        n0 = held_n[i, 0]
+        n1 = held_n[i, 1]
+        n2 = held_n[i, 2]
+    else:
+        n0 = (xs[i, 0] - ((1.0 - t) * xr[a, 0] + t * xr[b, 0])) / dist
+        n1 = (xs[i, 1] - ((1.0 - t) * xr[a, 1] + t * xr[b, 1])) / dist
+        n2 = (xs[i, 2] - ((1.0 - t) * xr[a, 2] + t * xr[b, 2])) / dist
     mrc = (1.0 - t) * mr[a] + t * mr[b]
     meff = mrc if fixed_s[i] else ms[i] * mrc / (ms[i] + mrc)
     k = k_held if fixed_s[i] else k_free
@@ -207,7 +213,7 @@ def _contact_one(c, xs, vs, ms, fixed_s, xr, vr, mr, seg, nodes, ptr, cand, radi
 
 
 @numba.njit(parallel=True, cache=True)
-def contact_kernel(xs, vs, ms, fixed_s, xr, vr, mr, seg, nodes, ptr, cand, radius, offset, k_free, k_held, zeta,
+def contact_kernel(xs, vs, ms, fixed_s, held_n, xr, vr, mr, seg, nodes, ptr, cand, radius, offset, k_free, k_held, zeta,
                    mu, v_slip, dt, fs, rod_seg, rod_t, rod_k, rod_f, damp_f, fric_f):
     """Penalty contact forces on the candidate wall nodes (added into ``fs``) and the reactions on
     the rod per candidate (``rod_seg`` = -1 if not in contact, ``rod_t``, ``rod_k`` the penalty
@@ -230,7 +236,7 @@ def contact_kernel(xs, vs, ms, fixed_s, xr, vr, mr, seg, nodes, ptr, cand, radiu
     n_active = 0
     normal = 0.0
     for c in numba.prange(nodes.shape[0]):
-        e, pd, pf, a, fn = _contact_one(c, xs, vs, ms, fixed_s, xr, vr, mr, seg, nodes, ptr, cand, radius, offset,
+        e, pd, pf, a, fn = _contact_one(c, xs, vs, ms, fixed_s, held_n, xr, vr, mr, seg, nodes, ptr, cand, radius, offset,
                                         k_free, k_held, zeta, mu, v_slip, dt, fs, rod_seg, rod_t, rod_k, rod_f,
                                         damp_f, fric_f)
         energy += e
@@ -242,7 +248,7 @@ def contact_kernel(xs, vs, ms, fixed_s, xr, vr, mr, seg, nodes, ptr, cand, radiu
 
 
 @numba.njit(cache=True)
-def contact_kernel_serial(xs, vs, ms, fixed_s, xr, vr, mr, seg, nodes, ptr, cand, radius, offset, k_free,
+def contact_kernel_serial(xs, vs, ms, fixed_s, held_n, xr, vr, mr, seg, nodes, ptr, cand, radius, offset, k_free,
                           k_held, zeta, mu, v_slip, dt, fs, rod_seg, rod_t, rod_k, rod_f, damp_f, fric_f):
     """Serial :func:`contact_kernel` for candidate lists too short to pay for threads."""
     energy = 0.0
@@ -251,7 +257,7 @@ def contact_kernel_serial(xs, vs, ms, fixed_s, xr, vr, mr, seg, nodes, ptr, cand
     n_active = 0
     normal = 0.0
     for c in range(nodes.shape[0]):
-        e, pd, pf, a, fn = _contact_one(c, xs, vs, ms, fixed_s, xr, vr, mr, seg, nodes, ptr, cand, radius, offset,
+        e, pd, pf, a, fn = _contact_one(c, xs, vs, ms, fixed_s, held_n, xr, vr, mr, seg, nodes, ptr, cand, radius, offset,
                                         k_free, k_held, zeta, mu, v_slip, dt, fs, rod_seg, rod_t, rod_k, rod_f,
                                         damp_f, fric_f)
         energy += e
@@ -343,10 +349,16 @@ class RodShellContact:
         Distance from the wall mid-surface to the contact surface, m (None: half the thickness).
     skin : float or None
         Extra search distance of the broad phase, m (None: half the rod radius).
+    held_normals : (n, 3) float or None
+        Unit normals of the wall at rest, pointing away from the rod's side (out of a tube's
+        lumen). Given, a held node is a point of a rigid smooth wall and pushes the rod along its
+        normal (docs/model.md, "Contact"): a held ring next to a bulged mobile wall is then a
+        boundary the tip slides along, not a ledge it catches on. None: held nodes push along the
+        line from the rod's axis to the node, like free ones.
     """
 
     def __init__(self, rod, shell, stiffness=None, damping_ratio=0.5, friction=0.0, slip_velocity=1e-3,
-                 offset=None, skin=None, held_stiffness=None):
+                 offset=None, skin=None, held_stiffness=None, held_normals=None):
         self.rod = rod
         self.shell = shell
         self.offset = 0.5 * shell.thickness if offset is None else float(offset)
@@ -372,6 +384,12 @@ class RodShellContact:
         self.slip_velocity = float(slip_velocity)
         self.cutoff = rod.radius + self.offset + self.skin
         self.cell = max(2.0 * self.cutoff, float(rod.rest_length.max()))
+        if held_normals is None:  # zeros: the kernel's flag to push along the axis-to-node line
+            self._held_normal = np.zeros_like(shell.x0)
+        else:
+            self._held_normal = np.ascontiguousarray(held_normals, dtype=np.float64)
+            if self._held_normal.shape != shell.x0.shape or not np.all(np.isfinite(self._held_normal)):
+                raise ColonsimError(f"held_normals must be finite unit vectors of shape {shell.x0.shape}; fix them.")
         self._xr_build = None
         self._xs_build = None
         self.n_rebuilds = 0
@@ -455,7 +473,7 @@ class RodShellContact:
             self.build_candidates(r.x, s.x)
         kernel = contact_kernel if len(self._nodes) >= self.parallel_min_candidates else contact_kernel_serial
         energy, p_damp, p_fric, n_active, normal = kernel(
-            s.x, s.v, self.shell.mass, s.fixed, r.x, r.v, self.rod.mass, self.rod.segments, self._nodes, self._ptr,
+            s.x, s.v, self.shell.mass, s.fixed, self._held_normal, r.x, r.v, self.rod.mass, self.rod.segments, self._nodes, self._ptr,
             self._cand, self.rod.radius, self.offset, self.stiffness, self.held_stiffness, self.damping_ratio,
             self.friction, self.slip_velocity, dt, s.f_con, self._rod_seg, self._rod_t, self._rod_k, self._rod_f,
             self._damp_f, self._fric_f,

@@ -439,6 +439,11 @@ class ExplicitSolver:
         Safety factor on the stable time step estimate (bodies and contact penalty).
     time_step_interval : int
         Steps between time step updates.
+    time_step_growth : float
+        Largest factor by which an update may raise the time step (a decrease applies at once).
+        A wall that goes slack (a scope snapping past a bend) lets the stable step double within
+        a few milliseconds; if it stiffens again before the next update, a step raised all the way
+        is unstable for up to ``time_step_interval`` steps (a THF run diverged so).
     mass_scaling : float or None
         Target time step, s: bodies whose stable step is smaller get their masses scaled uniformly
         by (target / dt_body)^2 (the added mass is reported in ``added_mass``).
@@ -452,7 +457,7 @@ class ExplicitSolver:
     """
 
     def __init__(self, bodies, contacts=(), constraints=(), loads=(), damping=0.0, time_step=None,
-                 time_step_factor=0.9, time_step_interval=100, mass_scaling=None, initial_velocity=None,
+                 time_step_factor=0.9, time_step_interval=100, time_step_growth=1.05, mass_scaling=None, initial_velocity=None,
                  energy_growth_limit=10.0, parallel_min_nodes=50_000):
         names = [b.name for b in bodies]
         if len(set(names)) != len(names):
@@ -484,6 +489,9 @@ class ExplicitSolver:
         self.fixed_time_step = time_step
         self.time_step_factor = float(time_step_factor)
         self.time_step_interval = int(time_step_interval)
+        if not time_step_growth >= 1.0:
+            raise ColonsimError(f"time_step_growth = {time_step_growth} must be >= 1; fix it.")
+        self.time_step_growth = float(time_step_growth)
         self.energy_growth_limit = float(energy_growth_limit)
         self.time = 0.0
         self.step = 0
@@ -524,7 +532,8 @@ class ExplicitSolver:
         if self.fixed_time_step is not None:
             self.dt = self.fixed_time_step
         else:
-            self.dt = self.time_step_factor * self.stable_time_step()
+            dt = self.time_step_factor * self.stable_time_step()
+            self.dt = dt if self.dt is None else min(dt, self.time_step_growth * self.dt)
 
     # -- one step ---------------------------------------------------------------------------
 
