@@ -207,8 +207,10 @@ def _add_insert(sub):
     p.add_argument("--wall-thickness", type=float, default=2.0, help="colon wall thickness, mm (default 2, an assumption)")
     p.add_argument("--element-size", type=float, default=3.0, help="wall triangle size, mm (default 3)")
     p.add_argument("--material", help="material JSON from colonsim calibrate (default: the source's parameters)")
-    p.add_argument("--exit-length", type=float, default=0.0,
-                   help="RSJ only: mm of fixed colon after the sigmoid (default 0, SPEC.md's model)")
+    p.add_argument("--flexure-angle", type=float, default=90.0,
+                   help="turn of the splenic (RSF) or hepatic (THF) flexure, degrees (default 90, an assumption)")
+    p.add_argument("--exit-length", type=float, default=100.0,
+                   help="mm of fixed colon after the last mobile piece (default 100, an assumption)")
     p.add_argument("--vtu", action="store_true", help="write deformed meshes for ParaView (needs meshio)")
     p.add_argument("--snapshot-every", type=float, default=0.02, help="simulated seconds between VTU snapshots")
     p.add_argument("--threads", type=int, default=None,
@@ -252,9 +254,8 @@ def run_insertions(cases, out: Path, vtu=False, snapshot_every=0.02, show=True):
               f"max {s['max_deformation_cm']:.2f} cm ({pts}); peak contact {s['peak_contact_force_N']:.2f} N, "
               f"peak push {s['peak_push_force_N']:.2f} N; quasi-static {'holds' if s['quasi_static']['holds'] else 'does NOT hold'} "
               f"(KE/IE < 10 %: colon {100 * s['quasi_static']['fraction_below_10pct']['colon']:.0f} %, "
-              f"scope {100 * s['quasi_static']['fraction_below_10pct']['scope']:.0f} % of samples, "
-              f"{100 * s['quasi_static']['scope_without_imposed_sliding']['fraction_below_10pct']:.0f} % without its "
-              f"imposed sliding); "
+              f"scope {100 * s['quasi_static']['fraction_below_10pct']['scope']:.0f} % of samples without its imposed "
+              f"sliding); ended: {s['end']['reason']} at {s['end']['depth_cm']:.1f} cm; "
               f"{s['steps']} steps in {s['wall_time_s']:.1f} s -> {folder}/")
     table = comparison_table(results)
     write_csv(out / "comparison.csv", table)
@@ -274,7 +275,8 @@ def cmd_insert(args):
         numba.set_num_threads(args.threads)
 
     cases = [InsertionCase(segment=args.segment, scope=scope, diameter_mm=args.diameter, angle_deg=args.angle,
-                           friction=args.friction, wall_thickness_mm=args.wall_thickness,
+                           flexure_angle_deg=args.flexure_angle, friction=args.friction,
+                           wall_thickness_mm=args.wall_thickness,
                            element_size_mm=args.element_size, material=args.material,
                            exit_length_mm=args.exit_length) for scope in args.scope]
     if args.material is not None:

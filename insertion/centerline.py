@@ -354,22 +354,28 @@ def _check_angle(what, value, low, high, why):
         raise ColonsimError(f"{what} = {value!r} deg is outside {low:g}-{high:g} deg ({why}); choose an angle in range.")
 
 
-def rsj_centerline(rectum_length=0.04, sigmoid_radius=FLEXURE_RADIUS, sigmoid_angle_deg=180.0, exit_length=0.0):
-    """Rectosigmoid junction: a straight fixed rectum, then the mobile sigmoid as one arc.
+EXIT_LENGTH = 0.10  # m, assumption: the fixed colon every model continues into after its last mobile piece
+FLEXURE_ANGLE_DEG = 90.0  # assumption: turn of the splenic and hepatic flexures
+
+
+def rsj_centerline(rectum_length=0.04, sigmoid_radius=FLEXURE_RADIUS, sigmoid_angle_deg=180.0,
+                   exit_length=EXIT_LENGTH):
+    """Rectosigmoid junction: a straight fixed rectum, the mobile sigmoid as one arc, a fixed exit.
 
     Parameters
     ----------
     rectum_length : float
-        m (SPEC.md: 4 cm).
+        m (4 cm).
     sigmoid_radius : float
-        m (SPEC.md: 5 cm).
+        m (5 cm).
     sigmoid_angle_deg : float
-        Turning angle of the sigmoid arc, deg (SPEC.md: 180); 0 < angle <= 180, beyond 180 the
-        arc would head back towards the anus.
+        Turning angle of the sigmoid arc, deg (180); 0 < angle <= 180, beyond 180 the arc would
+        head back towards the anus.
     exit_length : float
-        m, 0 (SPEC.md's model) or the length of a fixed straight ``"descending"`` piece after the
-        sigmoid (**assumption**: the start of the descending colon), so a scope tip passing the
-        sigmoid's end enters fixed colon instead of leaving the tube.
+        m, length of the fixed straight ``"descending"`` piece after the sigmoid (**assumption**
+        10 cm: the sigmoid-descending junction), so the scope is held at both ends of the mobile
+        arc and its tip enters fixed colon instead of leaving the tube; 0 ends the tube at the
+        sigmoid (the end ring is then the only hold at the far end).
     """
     _check_angle("sigmoid angle", sigmoid_angle_deg, 1e-9, 180.0, "the arc of the junction")
     pieces = [Straight(rectum_length, "fixed", "rectum"),
@@ -380,87 +386,92 @@ def rsj_centerline(rectum_length=0.04, sigmoid_radius=FLEXURE_RADIUS, sigmoid_an
 
 
 def rsf_centerline(alpha_deg=0.0, rectum_length=0.04, sigmoid_length=0.20, descending_length=0.10,
-                   flexure_radius=FLEXURE_RADIUS, flexure_angle_deg=90.0, fillet_radius=FILLET_RADIUS):
-    """Rectum to splenic flexure with the sigmoid tilted by ``alpha_deg``.
+                   flexure_radius=FLEXURE_RADIUS, flexure_angle_deg=FLEXURE_ANGLE_DEG, fillet_radius=FILLET_RADIUS,
+                   exit_length=EXIT_LENGTH):
+    """Rectum to splenic flexure with the sigmoid tilted by ``alpha_deg``, then a fixed exit.
 
     Reading of "tilted by alpha" (**assumption**): rectum and descending colon are parallel (the
     body's long axis, ``+y``); the straight sigmoid between them makes the angle alpha with that
     axis, leaning to the patient's left (``-n``, i.e. ``+x``) where the descending colon lies, so
     the descending colon is shifted laterally by about ``L sin(alpha)``. The splenic flexure then
-    turns medially (``+n``) by ``flexure_angle_deg``. alpha = 0 makes rectum, sigmoid and
-    descending colon one straight line. Both kinks get fillets; the largest alpha is set by the
-    fillet fitting on the rectum (``R_f tan(alpha/2) <= rectum``: 77 deg with the defaults).
+    turns medially (``+n``) by ``flexure_angle_deg`` into a fixed straight ``"transverse"`` exit
+    (the start of the transverse colon). alpha = 0 makes rectum, sigmoid and descending colon one
+    straight line. Both kinks get fillets; the largest alpha is set by the fillet fitting on the
+    rectum (``R_f tan(alpha/2) <= rectum``: 77 deg with the defaults).
 
     Parameters
     ----------
     alpha_deg : float
-        Sigmoid tilt, deg, 0 <= alpha < 90 (SPEC.md: 0, 30, 45).
+        Sigmoid tilt, deg, 0 <= alpha < 90 (0, 30, 45 in the study).
     rectum_length, sigmoid_length, descending_length : float
-        m (assumption 4 cm as in RSJ; SPEC.md 20 cm; SPEC.md 10 cm).
+        m (assumption 4 cm as in RSJ; 20 cm; 10 cm).
     flexure_radius : float
-        m (SPEC.md 5 cm).
+        m (5 cm).
     flexure_angle_deg : float
         Turn of the splenic flexure, deg (assumption 90: the transverse colon runs across).
     fillet_radius : float
         m (assumption 5 cm).
+    exit_length : float
+        m, fixed straight after the flexure (assumption 10 cm; 0: the tube ends at the flexure).
     """
     if not (np.isfinite(alpha_deg) and 0.0 <= alpha_deg < 90.0):
         raise ColonsimError(f"alpha = {alpha_deg!r} deg is outside 0 <= alpha < 90 deg (the sigmoid must climb "
                             "from the rectum to the descending colon); choose an angle in range.")
     _check_angle("splenic flexure angle", flexure_angle_deg, 1e-9, 180.0, "a flexure turns by at most 180 deg")
     a = np.radians(alpha_deg)
-    return Centerline([Straight(rectum_length, "fixed", "rectum"),
-                       Kink(-a),
-                       Straight(sigmoid_length, "mobile", "sigmoid"),
-                       Kink(a),
-                       Straight(descending_length, "fixed", "descending"),
-                       Arc(flexure_radius, np.radians(flexure_angle_deg), "fixed", "splenic flexure")],
-                      fillet_radius=fillet_radius)
+    pieces = [Straight(rectum_length, "fixed", "rectum"),
+              Kink(-a),
+              Straight(sigmoid_length, "mobile", "sigmoid"),
+              Kink(a),
+              Straight(descending_length, "fixed", "descending"),
+              Arc(flexure_radius, np.radians(flexure_angle_deg), "fixed", "splenic flexure")]
+    if exit_length != 0.0:
+        pieces.append(Straight(exit_length, "fixed", "transverse"))
+    return Centerline(pieces, fillet_radius=fillet_radius)
 
 
-def thf_centerline(beta_deg=0.0, span=0.20, lead_in_length=0.05, ascending_length=0.10,
-                   flexure_radius=FLEXURE_RADIUS, fillet_radius=FILLET_RADIUS, fixed_transverse=False):
-    """Splenic flexure, transverse colon drooping as a V of angle ``beta_deg``, hepatic flexure, ascending colon.
+def thf_centerline(beta_deg=0.0, span=0.20, flexure_radius=FLEXURE_RADIUS, flexure_angle_deg=FLEXURE_ANGLE_DEG,
+                   fillet_radius=FILLET_RADIUS, exit_length=EXIT_LENGTH, fixed_transverse=False):
+    """Transverse colon drooping as a V of angle ``beta_deg``, hepatic flexure, ascending colon.
 
-    Reading (**assumptions**): a straight lead-in (the top of the descending colon, ``+y``) gives
-    the scope a straight entry; the splenic flexure turns by 90 + beta; the transverse colon is
-    two straight arms at beta below and above the horizontal, each ``span / (2 cos beta)`` long,
-    so the flexure/transverse junctions are ``span`` apart (the straight-line distance of
-    SPEC.md) and the unrounded V sinks ``span tan(beta) / 2`` (longer and deeper with beta); a
-    fillet rounds the V bottom; the hepatic flexure turns by 90 + beta into the ascending colon
-    (``-y``). beta = 0 makes the transverse colon one straight piece.
+    Reading (**assumptions**): the scope enters the transverse colon directly at its splenic end
+    (the model holds no splenic flexure; the entry ring is held); the transverse colon is two
+    straight arms at beta below and above the line joining its ends, each ``span / (2 cos beta)``
+    long, so its ends are ``span`` apart (the straight-line distance) and the unrounded V sinks
+    ``span tan(beta) / 2`` (longer and deeper with beta); a fillet rounds the V bottom; the
+    hepatic flexure turns by ``flexure_angle_deg`` the other way from the V's bottom, into the
+    fixed ascending colon (the exit). beta = 0 makes the transverse colon one straight piece.
 
     Parameters
     ----------
     beta_deg : float
-        Droop angle, deg, 0 <= beta <= 60 (SPEC.md: 0, 30, 45); steeper Vs reach below the
-        lead-in and the ascending colon of the default lengths.
+        Droop angle, deg, 0 <= beta <= 60 (0, 30, 45 in the study).
     span : float
-        Straight-line distance between the ends of the transverse colon, m (SPEC.md 20 cm).
-    lead_in_length, ascending_length : float
-        m (assumption 5 cm, 0 allowed; SPEC.md 10 cm).
+        Straight-line distance between the ends of the transverse colon, m (20 cm).
     flexure_radius, fillet_radius : float
-        m (SPEC.md 5 cm; assumption 5 cm).
+        m (5 cm; assumption 5 cm).
+    flexure_angle_deg : float
+        Turn of the hepatic flexure, deg (assumption 90).
+    exit_length : float
+        Length of the fixed ascending colon, m (10 cm; 0: the tube ends at the flexure).
     fixed_transverse : bool
         True for the fixed THF model (no mobile part).
     """
     _check_angle("beta", beta_deg, 0.0, 60.0, "a steeper V is not a transverse colon")
+    _check_angle("hepatic flexure angle", flexure_angle_deg, 1e-9, 180.0, "a flexure turns by at most 180 deg")
     _check_length("span", span)
     b = np.radians(beta_deg)
     tag = "fixed" if fixed_transverse else "mobile"
     arm = 0.5 * span / np.cos(b)
-    pieces = []
-    if lead_in_length != 0.0:
-        pieces.append(Straight(lead_in_length, "fixed", "descending"))
-    pieces += [Arc(flexure_radius, 0.5 * np.pi + b, "fixed", "splenic flexure"),
-               Straight(arm, tag, "transverse"),
-               Kink(-2.0 * b),
-               Straight(arm, tag, "transverse"),
-               Arc(flexure_radius, 0.5 * np.pi + b, "fixed", "hepatic flexure"),
-               Straight(ascending_length, "fixed", "ascending")]
+    pieces = [Straight(arm, tag, "transverse"),
+              Kink(-2.0 * b),
+              Straight(arm, tag, "transverse"),
+              Arc(flexure_radius, np.radians(flexure_angle_deg), "fixed", "hepatic flexure")]
+    if exit_length != 0.0:
+        pieces.append(Straight(exit_length, "fixed", "ascending"))
     return Centerline(pieces, fillet_radius=fillet_radius)
 
 
 def thf_fixed_centerline(beta_deg=0.0, **kwargs):
-    """Fixed THF: :func:`thf_centerline` with the transverse colon fixed too (SPEC.md 2.1)."""
+    """Fixed THF: :func:`thf_centerline` with the transverse colon fixed too."""
     return thf_centerline(beta_deg, fixed_transverse=True, **kwargs)

@@ -1,21 +1,23 @@
-"""The colon models of the study as simulation-ready geometry (SPEC.md 2.1).
+"""The colon models of the study as simulation-ready geometry (docs/model.md, "Colon models").
 
-A thin layer over :mod:`insertion.centerline` (the centerlines, their fixed/mobile tags and the
-readings of SPEC.md 2.1, in the builders' docstrings) and :mod:`insertion.colon_geometry` (the
-tube mesh). It adds what an insertion run needs from a model (**assumptions** where marked):
+A thin layer over :mod:`insertion.centerline` (the centerlines, their fixed/mobile tags and their
+readings, in the builders' docstrings) and :mod:`insertion.colon_geometry` (the tube mesh). It
+adds what an insertion run needs from a model (**assumptions** where marked):
 
 - the wall is meshed at its mid-surface, diameter D + t, because contact acts half a thickness
   inside the mid-surface;
-- RSJ: optional ``exit_length``, a fixed straight after the sigmoid (the start of the descending
-  colon); the run then ends when the tip is D/2 past the sigmoid's end;
+- every model continues past its last mobile piece into a fixed exit (``exit_length``, 10 cm by
+  default), so the scope is held at both ends of the mobile part;
+- RSJ: the run ends when the tip is ``PAST_JUNCTION`` (2 cm) past the sigmoid's junction with
+  the fixed exit;
 - RSF: the sigmoid tilts by alpha towards the patient's left, away from the side the splenic
-  flexure turns to (the sigmoid runs laterally from the rectum to the descending colon, the
-  flexure turns medially; :func:`insertion.centerline.rsf_centerline`); alpha = 0 is one
-  straight line. Straightening ends where the splenic flexure starts;
-- THF / fixed THF: straightening ends where the hepatic flexure starts; the run ends when the
-  tip is D/2 past the hepatic flexure (the ascending colon only closes the tube);
-- while straightening, each mobile node may only move along the straight piece it belongs to
-  (``mobile_axes``): the sigmoid, or each transverse arm, the V-bottom fillet going with the first.
+  flexure turns to (:func:`insertion.centerline.rsf_centerline`); alpha = 0 is one straight line;
+- THF / fixed THF: the scope enters the transverse colon directly;
+- RSF, THF: straightening ends where the mobile part ends (``straighten_depth``); while
+  straightening, each mobile node may only move along the straight piece it belongs to
+  (``mobile_axes``): the sigmoid, or each transverse arm, the V-bottom fillet going with the
+  first. After it the push goes on until the scope's available length is used or the tip
+  reaches the model's far end (``end_depth`` = the centerline's length).
 
 :func:`colon_geometry` returns a :class:`ColonGeometry`. A straight tube (``"straight"``) is
 kept for sanity checks.
@@ -28,12 +30,14 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from colonsim.errors import ColonsimError
-from insertion.centerline import Straight, rsf_centerline, rsj_centerline, thf_centerline, thf_fixed_centerline
+from insertion.centerline import (EXIT_LENGTH, FLEXURE_ANGLE_DEG, Straight, rsf_centerline, rsj_centerline,
+                                  thf_centerline, thf_fixed_centerline)
 from insertion.colon_geometry import tube_mesh
 from insertion.sheet_mesh import straight_tube
 
 ANGLE_LIMIT_DEG = 60.0  # RSF alpha and THF beta; the source used 0, 30, 45
-EXIT_LIMIT = 0.3  # m, RSJ exit piece
+EXIT_LIMIT = 0.3  # m, fixed exit piece
+PAST_JUNCTION = 0.02  # m, an RSJ run ends when the tip is this far past the sigmoid's fixed end
 
 
 @dataclass
@@ -52,9 +56,11 @@ class ColonGeometry:
     centerline_points: object  # callable s -> (n, 3)
     straighten_depth: float | None = None
     mobile_axes: list = field(default_factory=list)
-    # arc length of the plane (normal to the centerline) the tip must cross to have "passed the
-    # fixed end" (SPEC.md 2.4); default: the far end ring
+    # arc length of the plane (normal to the centerline) whose crossing by the tip ends the run;
+    # default: the far end ring
     end_depth: float | None = None
+    # arc length where the mobile part ends (None: no mobile part)
+    mobile_end: float | None = None
 
     def __post_init__(self):
         if self.end_depth is None:
@@ -63,7 +69,8 @@ class ColonGeometry:
     def summary(self) -> dict:
         return {"segment": self.name, "wall_nodes": int(len(self.nodes)), "wall_triangles": int(len(self.triangles)),
                 "fixed_nodes": int(self.fixed.sum()), "mobile_nodes": int(self.mobile.sum()),
-                "end_ring_nodes": int(self.end_ring.sum()), "centerline_length_cm": self.centerline_length * 100}
+                "end_ring_nodes": int(self.end_ring.sum()), "centerline_length_cm": self.centerline_length * 100,
+                "mobile_end_cm": None if self.mobile_end is None else self.mobile_end * 100}
 
 
 def _mobile_axes(centerline, mesh, name):
@@ -92,18 +99,26 @@ def _mobile_axes(centerline, mesh, name):
     return [(d, nodes) for d, nodes in axes if nodes.size]
 
 
-def _geometry(name, centerline, diameter, element_size, wall_thickness, straighten_depth=None,
-              mobile_piece=None, end_depth=None) -> ColonGeometry:
+def mobile_end(centerline):
+    """Arc length where the last mobile piece ends, m (None when every piece is fixed)."""
+    ends = [end for piece, end in zip(centerline.pieces, centerline.s_end) if piece.tag == "mobile"]
+    return float(ends[-1]) if ends else None
+
+
+def _geometry(name, centerline, diameter, element_size, wall_thickness, mobile_piece=None,
+              end_depth=None) -> ColonGeometry:
     if 0.5 * diameter + wall_thickness >= centerline.min_radius:
         raise ColonsimError(f"a {diameter * 1e3:.0f} mm colon does not fit around a bend of radius "
                             f"{centerline.min_radius * 100:.0f} cm (the wall would fold); use a smaller --diameter")
     mesh = tube_mesh(centerline, diameter + wall_thickness, element_size)
     axes = [] if mobile_piece is None else _mobile_axes(centerline, mesh, mobile_piece)
+    end_mobile = mobile_end(centerline)
     return ColonGeometry(name, mesh.nodes, mesh.triangles, mesh.fixed & ~mesh.end_ring, mesh.mobile, mesh.end_ring,
                          entry_point=centerline.position(0.0), entry_axis=centerline.tangent(0.0),
                          centerline_length=centerline.length,
                          centerline_points=lambda s: centerline.position(np.atleast_1d(s)),
-                         straighten_depth=straighten_depth, mobile_axes=axes, end_depth=end_depth)
+                         straighten_depth=end_mobile if mobile_piece is not None else None, mobile_axes=axes,
+                         end_depth=end_depth, mobile_end=end_mobile)
 
 
 def straight_colon(length, diameter, element_size, wall_thickness, fixed_length=0.0) -> ColonGeometry:
@@ -119,7 +134,8 @@ def straight_colon(length, diameter, element_size, wall_thickness, fixed_length=
     )
 
 
-def colon_geometry(segment, diameter, angle_deg, element_size, wall_thickness, exit_length=0.0) -> ColonGeometry:
+def colon_geometry(segment, diameter, angle_deg, element_size, wall_thickness, exit_length=EXIT_LENGTH,
+                   flexure_angle_deg=FLEXURE_ANGLE_DEG) -> ColonGeometry:
     """The geometry of ``segment`` ("rsj", "rsf", "thf", "thf-fixed", or "straight").
 
     Parameters
@@ -130,7 +146,9 @@ def colon_geometry(segment, diameter, angle_deg, element_size, wall_thickness, e
     angle_deg : float
         RSF alpha or THF beta, 0-60 deg (ignored for RSJ and straight).
     exit_length : float
-        m, RSJ only, default 0 = SPEC.md's model: a fixed straight after the sigmoid.
+        m, the fixed straight every model continues into after its last mobile piece (10 cm).
+    flexure_angle_deg : float
+        Turn of the splenic (RSF) or hepatic (THF) flexure, deg (90).
     """
     if segment == "straight":
         return straight_colon(0.20, diameter, element_size, wall_thickness)
@@ -143,13 +161,12 @@ def colon_geometry(segment, diameter, angle_deg, element_size, wall_thickness, e
         raise ColonsimError(f"exit length {exit_length * 1e3:g} mm must lie in 0-{EXIT_LIMIT * 1e3:g} mm")
     if segment == "rsj":
         c = rsj_centerline(exit_length=exit_length)
-        end = c.bounds("sigmoid")[1] + 0.5 * diameter if exit_length > 0 else None
+        end = min(c.bounds("sigmoid")[1] + PAST_JUNCTION, c.length)
         return _geometry("rsj", c, diameter, element_size, wall_thickness, end_depth=end)
     if segment == "rsf":
-        c = rsf_centerline(angle_deg)
-        return _geometry("rsf", c, diameter, element_size, wall_thickness,
-                         straighten_depth=c.bounds("splenic flexure")[0], mobile_piece="sigmoid")
-    c = thf_fixed_centerline(angle_deg) if segment == "thf-fixed" else thf_centerline(angle_deg)
+        c = rsf_centerline(angle_deg, flexure_angle_deg=flexure_angle_deg, exit_length=exit_length)
+        return _geometry("rsf", c, diameter, element_size, wall_thickness, mobile_piece="sigmoid")
+    build = thf_fixed_centerline if segment == "thf-fixed" else thf_centerline
+    c = build(angle_deg, flexure_angle_deg=flexure_angle_deg, exit_length=exit_length)
     return _geometry(segment, c, diameter, element_size, wall_thickness,
-                     straighten_depth=c.bounds("hepatic flexure")[0], mobile_piece="transverse",
-                     end_depth=c.bounds("hepatic flexure")[1] + 0.5 * diameter)
+                     mobile_piece=None if segment == "thf-fixed" else "transverse")

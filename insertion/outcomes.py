@@ -102,3 +102,37 @@ def principal_stretches(x, triangles, dm_inv):
     half_trace = 0.5 * (C[:, 0, 0] + C[:, 1, 1])
     det = C[:, 0, 0] * C[:, 1, 1] - C[:, 0, 1] * C[:, 1, 0]
     return np.sqrt(half_trace + np.sqrt(np.maximum(half_trace**2 - det, 0.0)))
+
+
+JAM_PUSH = 0.02  # m of push over which the tip is watched
+JAM_PROGRESS = 1e-3  # m: less tip progress than this over JAM_PUSH of push, with the push force rising, is a jam
+
+
+def jammed(depth, tip_arc, push_force, window=JAM_PUSH, progress=JAM_PROGRESS):
+    """Has the tip stopped advancing while the push force rises, at the last sample?
+
+    The tip jams when, over the last ``window`` of push, it advanced less than ``progress`` along
+    the centerline while the push force rose (its mean over the second half of the window above
+    that over the first half; a mean, because the drive reaction rings at the scope's axial
+    frequencies).
+
+    Parameters
+    ----------
+    depth, tip_arc, push_force : (n,) arrays
+        Pushed distance (m), tip position along the centerline (m) and push force (N) per sample.
+    window, progress : float
+        m (2 cm and 1 mm by default).
+    """
+    z = np.asarray(depth, dtype=float)
+    if z.size < 3 or z[-1] - z[0] < window:
+        return False
+    start = int(np.searchsorted(z, z[-1] - window, side="right")) - 1
+    if start < 0 or z[-1] - z[start] < window:
+        return False
+    arc = np.asarray(tip_arc, dtype=float)
+    if arc[-1] - arc[start] >= progress:
+        return False
+    f = np.asarray(push_force, dtype=float)[start:]
+    mid = z[start] + 0.5 * (z[-1] - z[start])
+    first, second = f[z[start:] <= mid], f[z[start:] > mid]
+    return bool(first.size and second.size and second.mean() > first.mean())

@@ -1,4 +1,4 @@
-"""What an insertion records at every sample (SPEC.md 2.4), as a solver callback.
+"""What an insertion records at every sample (docs/model.md, "Outputs"), as a solver callback.
 
 Columns (SI): time_s, depth_m (pushed distance), deformation_m (largest nodal displacement of
 the mobile colon part), max_stretch (largest in-plane principal stretch of the wall), tip_displacement_m,
@@ -14,7 +14,7 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from insertion.outcomes import principal_stretches, sliding_kinetic_energy
+from insertion.outcomes import JAM_PUSH, jammed, principal_stretches, sliding_kinetic_energy
 
 
 class InsertionRecorder:
@@ -33,7 +33,7 @@ class InsertionRecorder:
         s = np.linspace(0.0, g.centerline_length, max(200, int(g.centerline_length / 1e-3)))
         self._arc = s
         self._arc_points = np.asarray(g.centerline_points(s))
-        # the plane the tip must cross to have "passed the fixed end" (SPEC.md 2.4)
+        # the plane whose crossing by the tip ends the run
         ends = np.clip([model.tip_end - 1e-4, model.tip_end, model.tip_end + 1e-4], 0.0, g.centerline_length)
         p = np.asarray(g.centerline_points(ends))
         self._end_point = p[1]
@@ -73,6 +73,19 @@ class InsertionRecorder:
         if self.snapshot_interval is not None and solver.time >= self._next_snapshot - 1e-12:
             self.snapshots.append((solver.time, colon.x.copy(), scope.x.copy()))
             self._next_snapshot += self.snapshot_interval
+
+    def jammed(self) -> bool:
+        """Has the tip jammed at the last sample (:func:`insertion.outcomes.jammed`)?"""
+        if not self.rows:
+            return False
+        depth = self.rows[-1]["depth_m"]
+        tail = []
+        for row in reversed(self.rows):  # the samples of the last window of push
+            tail.append(row)
+            if row["depth_m"] <= depth - JAM_PUSH:
+                break
+        tail.reverse()
+        return jammed([r["depth_m"] for r in tail], [r["tip_arc_m"] for r in tail], [r["push_force_N"] for r in tail])
 
     def frame(self) -> pd.DataFrame:
         return pd.DataFrame(self.rows)

@@ -38,7 +38,8 @@ def comparison_table(results) -> pd.DataFrame:
     """One row of scalar outcomes per run (cm, N), for comparing scopes or cases."""
     return pd.DataFrame([{"segment": r.case.segment, "scope": r.summary["scope"]["name"],
                            "scope_diameter_mm": r.summary["scope"]["diameter_mm"], "colon_diameter_mm": r.case.diameter_mm,
-                           "angle_deg": r.case.angle_deg, "friction": r.case.friction,
+                           "angle_deg": r.case.angle_deg, "flexure_angle_deg": r.case.flexure_angle_deg,
+                           "friction": r.case.friction,
                            "final_deformation_cm": r.summary["final_deformation_cm"],
                            "max_deformation_cm": r.summary["max_deformation_cm"],
                            **{f"point_{k}_cm": (None if v is None else v["deformation_cm"]) for k, v in r.summary["points_cm"].items()},
@@ -46,7 +47,7 @@ def comparison_table(results) -> pd.DataFrame:
                            "peak_push_force_N": r.summary["peak_push_force_N"],
                            "max_wall_stretch": r.summary["max_wall_stretch"],
                            "quasi_static": r.summary["quasi_static"]["holds"],
-                           "quasi_static_without_imposed_sliding": r.summary["quasi_static"]["holds_without_imposed_sliding"],
+                           "quasi_static_literal": r.summary["quasi_static"]["literal"]["holds"],
                            "ended_by": r.summary["ended_by"], "wall_time_s": r.summary["wall_time_s"]}
                           for r in results])
 

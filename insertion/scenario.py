@@ -1,26 +1,27 @@
-"""A colonoscopy insertion (SPEC.md 2): colon segment + scope + manoeuvre -> explicit simulation.
+"""A colonoscopy insertion (docs/model.md): colon model + scope + manoeuvre -> explicit simulation.
 
-:class:`InsertionCase` holds every input with the SPEC value as default (mm, degrees and cm/s
-are the user's units; SI inside). :func:`build_insertion` turns it into bodies, contact,
-constraints and a push profile; :func:`run_insertion` integrates and records the outputs of
-SPEC.md 2.4 through :class:`insertion.recording.InsertionRecorder`.
+:class:`InsertionCase` holds every input with the model's default (mm, degrees and m/s are the
+user's units; SI inside). :func:`build_insertion` turns it into bodies, contact, constraints and
+a push profile; :func:`run_insertion` integrates and records the outputs through
+:class:`insertion.recording.InsertionRecorder`.
 
 Modelling choices (stated so they can be cited):
 - the scope starts straight inside a rigid sheath on the extension of the colon entry axis, its
   tip at the entry plane; the sheath guides every scope node still behind the entry plane;
 - the proximal scope node is driven along the sheath axis by the push profile; the push force is
-  that constraint's reaction;
+  that constraint's reaction; at most the scope length less ``sheath_reserve_mm`` is pushed in
+  (the scope's available length);
 - fixed colon parts and the end rings are held (zero velocity); the mobile part is free;
 - quasi-static runs use mass-proportional damping, by default 60 1/s on the colon (about
   critical for its lowest bending modes of ~10 Hz) and 5 1/s on the scope (its rigid push
   through the sheath would otherwise feel a drag of alpha m v);
-- no gravity, no insufflation pressure (SPEC.md does not model them);
-- the run ends when the tip has passed the fixed end (SPEC.md 2.4): the tip node has crossed
-  the plane normal to the centerline at the model's end depth (the far end ring for RSJ, D/2
-  past the hepatic flexure for THF) while lying within one diameter of it along the centerline.
-  (A closest-point test along the centerline alone ends a run too early: a stiff scope rounds
-  the RSJ bend on a wider path than the centerline, and its tip projects onto the end of the
-  arc while still centimetres short of the end ring.)
+- no gravity, no insufflation pressure;
+- a run ends (``ended_by``) when the tip crosses the plane normal to the centerline at the
+  model's end depth while lying within one diameter of it along the centerline
+  (``"tip_past_end"``: for RSJ 2 cm past the sigmoid's fixed end; ``"far_end"``: for RSF/THF the
+  far end of the fixed exit, beyond which the tip would leave the model), when the available
+  length is pushed in (``"length_used"``), or when the tip jams (``"jam"``, :func:`insertion.outcomes.jammed`). A jam is an
+  outcome: the summary says where and under which forces.
 """
 
 from __future__ import annotations
@@ -39,14 +40,14 @@ from insertion.colon_segments import colon_geometry
 from insertion.contact import RodShellContact
 from insertion.manoeuvre import PushProfile, continuous_push, straighten_relax_push
 from insertion.material import REFERENCE_MATERIAL_PATH, load_material
-from insertion.outcomes import characteristic_points, quasi_static_fraction
+from insertion.outcomes import characteristic_points, jammed, quasi_static_fraction
 from insertion.recording import InsertionRecorder
 from insertion.scopes import colonoscope
 from insertion.shell import Shell
 from insertion.solver import ExplicitSolver, FixedNodes, LineConstraint, PrescribedVelocity
 
 SEGMENTS = ("rsj", "rsf", "thf", "thf-fixed", "straight")
-# SPEC.md 2.1; "straight" is the sanity case (a 20 cm straight tube), not one of the source's models.
+# the source's scope lengths; "straight" is the sanity case (a 20 cm straight tube), not one of its models.
 SCOPE_LENGTH_M = {"rsj": 0.30, "rsf": 0.70, "thf": 0.50, "thf-fixed": 0.50, "straight": 0.30}
 COLON_DENSITY = 1040.0  # kg/m^3
 
@@ -57,13 +58,17 @@ class InsertionCase:
 
     Attributes
     ----------
-    segment : {"rsj", "rsf", "thf", "thf-fixed"}
+    segment : {"rsj", "rsf", "thf", "thf-fixed", "straight"}
     scope : str
         ``utc``, ``pdc``, ``sdc`` or an outer diameter in mm.
     diameter_mm : float
-        Colon inner diameter (SPEC.md: 23 or 36 for RSJ; 36 assumed elsewhere).
+        Colon inner diameter (the source: 23 or 36 for RSJ; 36 assumed elsewhere).
     angle_deg : float
         alpha of RSF or beta of THF (ignored for RSJ).
+    flexure_angle_deg : float
+        Turn of the splenic (RSF) or hepatic (THF) flexure (**assumption** 90).
+    exit_length_mm : float
+        Fixed colon after the last mobile piece (**assumption** 100; for THF the ascending colon).
     friction : float
         Coulomb coefficient mu between scope and wall.
     wall_thickness_mm : float
@@ -73,7 +78,9 @@ class InsertionCase:
     element_size_mm, scope_spacing_mm : float
         Wall triangle size and scope node spacing.
     push_speed : float
-        Plateau push speed, m/s (SPEC.md: 0.6).
+        Plateau push speed, m/s (the source: 0.6).
+    sheath_reserve_mm : float
+        Scope length that stays in the sheath at the end of the push (**assumption** 20).
     ramp_s, relax_s : float
         Speed-change ramp and the relax pause of RSF/THF, s.
     colon_damping, scope_damping : float
@@ -88,6 +95,7 @@ class InsertionCase:
     scope: str = "sdc"
     diameter_mm: float = 36.0
     angle_deg: float = 0.0
+    flexure_angle_deg: float = 90.0
     friction: float = 0.0
     wall_thickness_mm: float = 2.0
     material: str | None = None
@@ -96,7 +104,8 @@ class InsertionCase:
     push_speed: float = 0.6
     ramp_s: float = 0.05
     relax_s: float = 0.1
-    exit_length_mm: float = 0.0
+    exit_length_mm: float = 100.0
+    sheath_reserve_mm: float = 20.0
     colon_damping: float = 60.0
     scope_damping: float = 5.0
     record_interval_s: float = 1e-3
@@ -118,7 +127,9 @@ class InsertionCase:
             ("time_step_factor", self.time_step_factor, 0.01, 1.0, "a safety factor in (0, 1]"),
             ("ramp_s", self.ramp_s, 0.0, 10.0, "ramp duration in s"),
             ("relax_s", self.relax_s, 0.0, 10.0, "relax duration in s"),
-            ("exit_length_mm", self.exit_length_mm, 0.0, 300.0, "RSJ exit length in mm (0: SPEC.md's model)"),
+            ("exit_length_mm", self.exit_length_mm, 0.0, 300.0, "fixed exit length in mm (100 by default)"),
+            ("flexure_angle_deg", self.flexure_angle_deg, 1.0, 180.0, "flexure turn in degrees (90 by default)"),
+            ("sheath_reserve_mm", self.sheath_reserve_mm, 0.0, 200.0, "scope length kept in the sheath, mm (20)"),
         ]
         for name, value, lo, hi, what in checks:
             if not (isinstance(value, (int, float)) and math.isfinite(value) and lo <= value <= hi):
@@ -164,7 +175,7 @@ def build_insertion(case: InsertionCase) -> Insertion:
     case.validate()
     D = case.diameter_mm * 1e-3
     geometry = colon_geometry(case.segment, D, case.angle_deg, case.element_size_mm * 1e-3,
-                              case.wall_thickness_mm * 1e-3, case.exit_length_mm * 1e-3)
+                              case.wall_thickness_mm * 1e-3, case.exit_length_mm * 1e-3, case.flexure_angle_deg)
     material = load_material(case.material or REFERENCE_MATERIAL_PATH)
     shell = Shell(geometry.nodes, geometry.triangles, case.wall_thickness_mm * 1e-3, material,
                   density=COLON_DENSITY, name="colon")
@@ -173,14 +184,15 @@ def build_insertion(case: InsertionCase) -> Insertion:
     entry = np.asarray(geometry.entry_point, dtype=float)
     axis = np.asarray(geometry.entry_axis, dtype=float)
     axis = axis / np.linalg.norm(axis)
-    # The run ends when the tip has passed the fixed end (the plane at end_depth). The
-    # scope lags behind the pushed depth when it bows, so the push may go up to 1.6 x further
-    # (a cap that also stops a scope that loops without progress); the scope starts wholly in
-    # the sheath, so it must be longer than that: the source's lengths (SPEC.md 2.1) are kept
-    # where they suffice, else lengthened (the summary reports the length used).
+    length = SCOPE_LENGTH_M[case.segment]
+    total_depth = length - case.sheath_reserve_mm * 1e-3
     tip_end = geometry.end_depth
-    length = max(SCOPE_LENGTH_M[case.segment], tip_end + 0.05)
-    total_depth = max(min(1.6 * tip_end, length - 0.02), tip_end)
+    if case.segment in ("rsj", "straight") and total_depth <= tip_end:
+        raise ColonsimError(f"a {length * 100:.0f} cm scope with {case.sheath_reserve_mm:g} mm kept in the sheath "
+                            f"cannot reach {tip_end * 100:.1f} cm into the colon; shorten --exit-length")
+    if geometry.straighten_depth is not None and total_depth <= geometry.straighten_depth:
+        raise ColonsimError(f"a {length * 100:.0f} cm scope cannot pass the mobile part ending "
+                            f"{geometry.straighten_depth * 100:.1f} cm in; reduce --sheath-reserve")
     rod = scope.rod(start=entry - length * axis, direction=axis, length=length,
                     spacing=case.scope_spacing_mm * 1e-3)
     if geometry.straighten_depth is None:
@@ -189,7 +201,9 @@ def build_insertion(case: InsertionCase) -> Insertion:
         push = straighten_relax_push(geometry.straighten_depth, total_depth, case.push_speed, case.ramp_s,
                                      max(case.relax_s, case.ramp_s))
 
-    contact = RodShellContact(rod, shell, friction=case.friction)
+    # tube meshes are oriented with normals out of the lumen: the fixed wall's rest normals
+    contact = RodShellContact(rod, shell, friction=case.friction,
+                              held_normals=shell.node_normals(np.ascontiguousarray(shell.x0)))
     held = np.flatnonzero(geometry.fixed | geometry.end_ring)
     constraints = [FixedNodes(shell, held)]
     mobile = np.flatnonzero(geometry.mobile & ~geometry.end_ring)
@@ -213,7 +227,7 @@ def build_insertion(case: InsertionCase) -> Insertion:
 
 @dataclass
 class InsertionResult:
-    """Recorded time series (SI columns), the summary of SPEC.md 2.4 and optional snapshots."""
+    """Recorded time series (SI columns), the run's summary and optional snapshots."""
 
     case: InsertionCase
     timeseries: object  # pandas.DataFrame
@@ -240,24 +254,45 @@ def run_insertion(case: InsertionCase, progress=None, snapshot_interval=None, ch
     t0 = time.perf_counter()
     duration = model.push.duration
     last_phase = model.push.phases[-1]
-    ended_by = f"push depth cap {model.total_depth * 100:.1f} cm reached before the tip passed the fixed end"
+    ended_by = "length_used"
     while model.solver.time < duration - 1e-9:
         step = min(chunk_s, duration - model.solver.time)
         model.solver.run(step, record_interval=case.record_interval_s, callbacks=[recorder])
         if not recorder.rows or recorder.rows[-1]["time_s"] < model.solver.time:
             recorder(model.solver)  # the state at the end of every chunk is a sample
         last = recorder.rows[-1]
-        tip_arc = last["tip_arc_m"]
         if progress is not None:
-            progress(tip_arc, model.tip_end)
+            progress(last["tip_arc_m"], model.tip_end)
         if model.solver.time >= last_phase.start and tip_passed_end(last, model):
-            ended_by = "the tip passed the fixed end"
+            ended_by = "tip_past_end" if model.geometry.end_depth < model.geometry.centerline_length else "far_end"
+            break
+        if recorder.jammed():
+            ended_by = "jam"
             break
     wall = time.perf_counter() - t0
     frame = recorder.frame()
     summary = summarize(model, frame, wall, t0 - t_build)
     summary["ended_by"] = ended_by
+    summary["end"] = end_state(model, frame, ended_by)
     return InsertionResult(case, frame, summary, recorder.snapshots, model)
+
+
+ENDINGS = {
+    "tip_past_end": "the tip passed the fixed end",
+    "far_end": "the tip reached the model's far end",
+    "length_used": "the scope's available length was pushed in",
+    "jam": "the tip jammed: under 1 mm of tip progress over 2 cm of push while the push force rose",
+}
+
+
+def end_state(model: Insertion, ts, ended_by) -> dict:
+    """Where and under which forces a run ended (``ended_by`` explained, depth, tip, forces)."""
+    last = ts.iloc[-1]
+    reason = ENDINGS[ended_by]
+    if ended_by == "length_used" and model.case.segment in ("rsj", "straight"):
+        reason += " before the tip passed the fixed end"
+    return {"reason": reason, "depth_cm": float(last["depth_m"] * 100), "tip_arc_cm": float(last["tip_arc_m"] * 100),
+            "push_force_N": float(last["push_force_N"]), "contact_force_N": float(last["contact_force_N"])}
 
 
 def tip_passed_end(sample, model: Insertion) -> bool:
@@ -289,15 +324,13 @@ def summarize(model: Insertion, ts, wall_s, build_s) -> dict:
         "max_wall_stretch": float(ts["max_stretch"].max()),
         "final_tip_arc_cm": float(ts["tip_arc_m"].iloc[-1] * 100),
         "quasi_static": {
-            "criterion": "kinetic / internal energy < 10 % on most (> 50 %) of the samples, per body (SPEC.md 2.3)",
-            "fraction_below_10pct": qs,
-            "holds": bool(all(f > 0.5 for f in qs.values())),
-            "scope_without_imposed_sliding": {
-                "fraction_below_10pct": sliding,
-                "meaning": "the scope's kinetic energy less that of sliding along itself at the push speed "
-                           "(imposed kinematics, not inertia)",
-            },
-            "holds_without_imposed_sliding": bool(qs["colon"] > 0.5 and sliding > 0.5),
+            "criterion": "kinetic / internal energy < 10 % on most (> 50 %) of the samples, per body, the scope's "
+                         "kinetic energy taken less that of sliding along itself at the push speed (imposed "
+                         "kinematics, not inertia); the rate check (half push speed) is run separately",
+            "fraction_below_10pct": {"colon": qs["colon"], "scope": sliding},
+            "holds": bool(qs["colon"] > 0.5 and sliding > 0.5),
+            "literal": {"fraction_below_10pct": qs, "holds": bool(all(f > 0.5 for f in qs.values())),
+                        "meaning": "the scope's whole kinetic energy, imposed sliding included"},
         },
         "simulated_time_s": float(ts["time_s"].iloc[-1]),
         "steps": int(model.solver.step),

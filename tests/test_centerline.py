@@ -1,13 +1,25 @@
-"""Centerlines of the colon models (SPEC.md 2.1): lengths, smoothness, frames, tags, bad input."""
+"""Centerlines of the colon models: lengths, end points, smoothness, frames, tags, bad input."""
 
 import numpy as np
 import pytest
 
 from colonsim.errors import ColonsimError
-from insertion.centerline import (FILLET_RADIUS, FLEXURE_RADIUS, Arc, Centerline, Kink, Straight, rsf_centerline,
-                                  rsj_centerline, thf_centerline, thf_fixed_centerline)
+from insertion.centerline import (EXIT_LENGTH, FILLET_RADIUS, FLEXURE_ANGLE_DEG, FLEXURE_RADIUS, Arc, Centerline,
+                                  Kink, Straight, rsf_centerline, rsj_centerline, thf_centerline, thf_fixed_centerline)
 
 R, RF = FLEXURE_RADIUS, FILLET_RADIUS
+
+
+def test_default_exit_and_flexure_angle():
+    # the model's documented defaults; every expected value below is derived from these
+    assert EXIT_LENGTH == 0.10 and FLEXURE_ANGLE_DEG == 90.0
+
+
+def _left_turn(p, t, radius, angle):
+    """End point and tangent of an in-plane (x-y) arc turning counter-clockwise by ``angle`` from (p, t)."""
+    left = np.cross([0.0, 0.0, 1.0], t)
+    return (p + radius * np.sin(angle) * t + radius * (1 - np.cos(angle)) * left,
+            np.cos(angle) * t + np.sin(angle) * left)
 
 
 def _helix_like():
@@ -20,36 +32,63 @@ def _helix_like():
 MODELS = {
     "rsj": rsj_centerline,
     "rsf45": lambda: rsf_centerline(45.0),
+    "rsf45-180": lambda: rsf_centerline(45.0, flexure_angle_deg=180.0),
     "thf30": lambda: thf_centerline(30.0),
     "thf45": lambda: thf_centerline(45.0),
+    "thf45-180": lambda: thf_centerline(45.0, flexure_angle_deg=180.0),
     "3d": _helix_like,
 }
 
 
-def test_rsj_length_is_rectum_plus_half_circle():
-    c = rsj_centerline()
-    assert c.length == pytest.approx(0.04 + np.pi * R, rel=1e-12)
+@pytest.mark.parametrize("kwargs, exit_length", [({}, EXIT_LENGTH), ({"exit_length": 0.05}, 0.05),
+                                                ({"exit_length": 0.0}, 0.0)])
+def test_rsj_is_rectum_half_circle_then_fixed_exit(kwargs, exit_length):
+    c = rsj_centerline(**kwargs)
+    assert c.length == pytest.approx(0.04 + np.pi * R + exit_length, rel=1e-12)
+    expected = [("rectum", "fixed"), ("sigmoid", "mobile")] + [("descending", "fixed")] * (exit_length > 0)
+    assert [(p.name, p.tag) for p in c.pieces] == expected
+    s1 = c.bounds("sigmoid")[1]
+    assert s1 == pytest.approx(0.04 + np.pi * R, rel=1e-12)
     # the 180 deg arc ends 2R to the side (+n = -x), at the rectum's height, heading back down
-    p, t, _, _ = c.frame(c.length)
+    p, t, _, _ = c.frame(s1)
     assert p == pytest.approx([-2 * R, 0.04, 0.0], abs=1e-12)
     assert t == pytest.approx([0.0, -1.0, 0.0], abs=1e-12)
+    # the exit carries straight on down from there
+    p, t, _, _ = c.frame(c.length)
+    assert p == pytest.approx([-2 * R, 0.04 - exit_length, 0.0], abs=1e-12)
+    assert t == pytest.approx([0.0, -1.0, 0.0], abs=1e-12)
+    if exit_length:
+        assert c.bounds("descending") == pytest.approx((s1, c.length), rel=1e-12)
+        assert c.tag_at(s1 + 1e-6) == "fixed" and c.name_at(c.length) == "descending"
 
 
-def test_rsj_exit_piece_continues_fixed_after_the_sigmoid():
-    c = rsj_centerline(exit_length=0.05)
-    assert c.length == pytest.approx(0.04 + np.pi * R + 0.05, rel=1e-12)
-    assert c.bounds("sigmoid")[1] == pytest.approx(0.04 + np.pi * R, rel=1e-12)
-    assert c.tag_at(c.length - 0.01) == "fixed" and c.name_at(c.length - 0.01) == "descending"
-    # it carries on from the half circle's end, heading back down
-    assert c.position(c.length) == pytest.approx([-2 * R, -0.01, 0.0], abs=1e-12)
-
-
+@pytest.mark.parametrize("flexure", [90.0, 135.0, 180.0])
 @pytest.mark.parametrize("alpha", [0.0, 30.0, 45.0])
-def test_rsf_length_with_fillets(alpha):
-    a = np.radians(alpha)
-    # each of the two fillets trims R_f tan(a/2) off both neighbours and adds an arc of R_f a
-    expected = 0.04 + 0.20 + 0.10 - 4 * RF * np.tan(a / 2) + 2 * RF * a + R * np.pi / 2
-    assert rsf_centerline(alpha).length == pytest.approx(expected, rel=1e-12)
+def test_rsf_length_with_fillets_flexure_and_exit(alpha, flexure):
+    a, phi = np.radians(alpha), np.radians(flexure)
+    c = rsf_centerline(alpha, flexure_angle_deg=flexure)
+    # each of the two fillets trims R_f tan(a/2) off both neighbours and adds an arc of R_f a;
+    # the splenic flexure adds R phi and the fixed exit its own length
+    expected = 0.04 + 0.20 + 0.10 - 4 * RF * np.tan(a / 2) + 2 * RF * a + R * phi + EXIT_LENGTH
+    assert c.length == pytest.approx(expected, rel=1e-12)
+    assert c.bounds("transverse") == pytest.approx((c.length - EXIT_LENGTH, c.length), rel=1e-12)
+    assert [(p.name, p.tag) for p in c.pieces[-2:]] == [("splenic flexure", "fixed"), ("transverse", "fixed")]
+    # the flexure starts where the unrounded descending colon ends (fillets do not move it), heading +y,
+    # and turns medially (+n = -x) by phi
+    f0, f1 = c.bounds("splenic flexure")
+    start = np.array([0.20 * np.sin(a), 0.04 + 0.20 * np.cos(a) + 0.10, 0.0])
+    assert c.position(f0) == pytest.approx(start, abs=1e-12)
+    assert c.tangent(f0) == pytest.approx([0.0, 1.0, 0.0], abs=1e-12)
+    p, t = _left_turn(start, np.array([0.0, 1.0, 0.0]), R, phi)
+    assert t == pytest.approx([-np.sin(phi), np.cos(phi), 0.0], abs=1e-12)
+    assert c.position(f1) == pytest.approx(p, abs=1e-12) and c.tangent(f1) == pytest.approx(t, abs=1e-12)
+    assert c.position(c.length) == pytest.approx(p + EXIT_LENGTH * t, abs=1e-12)
+    assert c.tangent(c.length) == pytest.approx(t, abs=1e-12)
+    # exit 0: the tube ends at the flexure
+    bare = rsf_centerline(alpha, flexure_angle_deg=flexure, exit_length=0.0)
+    assert bare.length == pytest.approx(expected - EXIT_LENGTH, rel=1e-12)
+    assert bare.pieces[-1].name == "splenic flexure"
+    assert bare.position(bare.length) == pytest.approx(p, abs=1e-12)
 
 
 def test_rsf_sigmoid_tilted_by_alpha_descending_parallel_to_rectum():
@@ -63,21 +102,56 @@ def test_rsf_sigmoid_tilted_by_alpha_descending_parallel_to_rectum():
     assert c.position(s0)[0] == pytest.approx(0.20 * np.sin(a), abs=1e-12)
 
 
+@pytest.mark.parametrize("flexure", [90.0, 180.0])
 @pytest.mark.parametrize("beta", [0.0, 30.0, 45.0])
-def test_thf_length_span_and_depth(beta):
-    b = np.radians(beta)
-    c = thf_centerline(beta)
-    # lead-in + two flexures of 90 + beta + two arms span/(2 cos b) - V fillet trims + fillet arc + ascending
-    expected = 0.05 + 2 * R * (np.pi / 2 + b) + 0.20 / np.cos(b) - 2 * RF * np.tan(b) + RF * 2 * b + 0.10
+def test_thf_length_span_depth_flexure_and_exit(beta, flexure):
+    b, phi = np.radians(beta), np.radians(flexure)
+    c = thf_centerline(beta, flexure_angle_deg=flexure)
+    # two arms span/(2 cos b) - V fillet trims + fillet arc + hepatic flexure of phi + ascending exit
+    expected = 0.20 / np.cos(b) - 2 * RF * np.tan(b) + RF * 2 * b + R * phi + EXIT_LENGTH
     assert c.length == pytest.approx(expected, rel=1e-12)
-    start = c.position(c.bounds("splenic flexure")[1])
-    end = c.position(c.bounds("hepatic flexure")[0])
+    # the scope enters the transverse colon directly along its first arm: no lead-in, no splenic flexure
+    assert c.name_at(0.0) == "transverse" and c.tag_at(0.0) == "mobile"
+    assert c.tangent(0.0) == pytest.approx([0.0, 1.0, 0.0], abs=1e-12)
+    s_end = c.bounds("hepatic flexure")[0]
+    assert c.bounds("transverse") == pytest.approx((0.0, s_end), abs=1e-15)
+    assert len([p for p in c.pieces if p.name == "transverse"]) == (1 if beta == 0 else 3)
+    start, end = c.position(0.0), c.position(s_end)
+    chord = (end - start) / 0.20
     assert np.linalg.norm(end - start) == pytest.approx(0.20, rel=1e-12)
-    s = np.linspace(*c.bounds("transverse"), 4001)
-    lowest = c.position(s)[:, 1].min()
+    # each arm lies at beta to the line joining the ends: that line heads beta clockwise of the first arm
+    assert chord == pytest.approx([np.sin(b), np.cos(b), 0.0], abs=1e-12)
+    s = np.linspace(0.0, s_end, 4001)
+    # distance from that line, positive on its left (+n), where the V's bottom lies
+    off = np.cross(chord, c.position(s) - start)[:, 2]
+    assert off.min() > -1e-12
     # the sharp V sinks span tan(b)/2; the fillet at its bottom lifts it by R_f (1/cos b - 1);
     # sampling every 0.1 mm misses the exact bottom by at most (0.05 mm)^2 / (2 R_f) < 1e-7 m
-    assert start[1] - lowest == pytest.approx(0.10 * np.tan(b) - RF * (1 / np.cos(b) - 1), abs=1e-7)
+    assert off.max() == pytest.approx(0.10 * np.tan(b) - RF * (1 / np.cos(b) - 1), abs=1e-7)
+    # the hepatic flexure turns by phi counter-clockwise (the other way from the V-bottom kink) from
+    # the second arm, heading -2 beta from +y, into the fixed ascending colon
+    t2 = np.array([np.sin(2 * b), np.cos(2 * b), 0.0])
+    assert c.tangent(s_end) == pytest.approx(t2, abs=1e-12)
+    p, t = _left_turn(end, t2, R, phi)
+    assert t == pytest.approx([-np.sin(phi - 2 * b), np.cos(phi - 2 * b), 0.0], abs=1e-12)
+    a0, a1 = c.bounds("ascending")
+    assert (a0, a1) == pytest.approx((c.length - EXIT_LENGTH, c.length), rel=1e-12)
+    assert c.position(a0) == pytest.approx(p, abs=1e-12) and c.tangent(a0) == pytest.approx(t, abs=1e-12)
+    assert c.position(c.length) == pytest.approx(p + EXIT_LENGTH * t, abs=1e-12)
+    bare = thf_centerline(beta, flexure_angle_deg=flexure, exit_length=0.0)
+    assert bare.length == pytest.approx(expected - EXIT_LENGTH, rel=1e-12)
+    assert bare.pieces[-1].name == "hepatic flexure"
+    assert bare.position(bare.length) == pytest.approx(p, abs=1e-12)
+    fixed = thf_fixed_centerline(beta, flexure_angle_deg=flexure)
+    assert fixed.length == c.length and {p.tag for p in fixed.pieces} == {"fixed"}
+    assert fixed.position(fixed.length) == pytest.approx(c.position(c.length), abs=1e-15)
+
+
+def test_thf_has_no_splenic_flexure_or_lead_in():
+    c = thf_centerline(30.0)
+    for name in ("splenic flexure", "descending"):
+        with pytest.raises(ColonsimError, match=f"no piece called '{name}'"):
+            c.bounds(name)
 
 
 def test_fillet_length_is_radius_times_angle():
@@ -134,7 +208,7 @@ def test_frame_orthonormal_and_rotation_minimising(name):
     assert np.abs(np.einsum("ij,ij->i", dn, b[1:-1])).max() < 1e-6
 
 
-@pytest.mark.parametrize("name", ["rsj", "rsf45", "thf45"])
+@pytest.mark.parametrize("name", ["rsj", "rsf45", "rsf45-180", "thf45", "thf45-180"])
 def test_planar_frame_does_not_twist(name):
     c = MODELS[name]()
     _, t, n, b = c.frame(np.linspace(0.0, c.length, 1001))
@@ -164,12 +238,22 @@ def test_tags_and_names():
     gap = np.linalg.norm(c.position(corner) - [0.0, 0.04, 0.0])
     assert gap == pytest.approx(FILLET_RADIUS * (1 / np.cos(0.5 * a) - 1), rel=1e-9)
     assert list(c.tag_at(np.array([0.0, mid, c.length]))) == ["fixed", "mobile", "fixed"]
+    # RSF: everything after the sigmoid's far half-fillet is fixed, the exit included
+    assert [(p.name, p.tag) for p in c.pieces] == [
+        ("rectum", "fixed"), ("rectum-sigmoid fillet", "fixed"), ("rectum-sigmoid fillet", "mobile"),
+        ("sigmoid", "mobile"), ("sigmoid-descending fillet", "mobile"), ("sigmoid-descending fillet", "fixed"),
+        ("descending", "fixed"), ("splenic flexure", "fixed"), ("transverse", "fixed")]
+    assert c.name_at(c.length) == "transverse"
     thf = thf_centerline(30.0)
     assert thf.tag_at(0.5 * np.add(*thf.bounds("transverse"))) == "mobile"
-    # the V bottom between two mobile arms is mobile and belongs to the transverse colon
-    assert {p.tag for p in thf.pieces if p.name == "transverse"} == {"mobile"}
+    # the V bottom between two mobile arms is mobile and belongs to the transverse colon; the
+    # hepatic flexure and the ascending colon (the exit) are fixed
+    assert [(p.name, p.tag) for p in thf.pieces] == [("transverse", "mobile")] * 3 + [
+        ("hepatic flexure", "fixed"), ("ascending", "fixed")]
+    assert list(thf.tag_at(np.array([0.0, thf.length]))) == ["mobile", "fixed"]
     assert {p.tag for p in thf_fixed_centerline(30.0).pieces} == {"fixed"}
-    assert rsj_centerline().tag_at(0.1) == "mobile"
+    rsj = rsj_centerline()
+    assert rsj.tag_at(0.1) == "mobile" and rsj.tag_at(rsj.length) == "fixed"
 
 
 def _clash():
@@ -185,6 +269,12 @@ BAD = [
     (lambda: rsf_centerline(30.0, fillet_radius=-0.01), "fillet radius"),
     (lambda: thf_centerline(70.0), "beta"),
     (lambda: thf_centerline(float("nan")), "beta"),
+    (lambda: rsf_centerline(flexure_angle_deg=0.0), "splenic flexure angle"),
+    (lambda: rsf_centerline(flexure_angle_deg=181.0), "splenic flexure angle"),
+    (lambda: thf_centerline(flexure_angle_deg=200.0), "hepatic flexure angle"),
+    (lambda: thf_centerline(flexure_angle_deg=float("nan")), "hepatic flexure angle"),
+    (lambda: rsf_centerline(exit_length=-0.01), "length of transverse"),
+    (lambda: thf_centerline(exit_length=float("nan")), "length of ascending"),
     (lambda: rsj_centerline(sigmoid_angle_deg=200.0), "sigmoid angle"),
     (lambda: rsj_centerline(sigmoid_angle_deg=0.0), "sigmoid angle"),
     (lambda: rsj_centerline(rectum_length=-0.01), "length of rectum"),

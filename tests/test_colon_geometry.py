@@ -38,7 +38,9 @@ MESHES = {
     "rsj23": lambda: tube_mesh(rsj_centerline(), 0.023, H),
     "rsj36": lambda: tube_mesh(rsj_centerline(), 0.036, H),
     "rsf45": lambda: tube_mesh(rsf_centerline(45.0), 0.036, H),
+    "rsf45-180": lambda: tube_mesh(rsf_centerline(45.0, flexure_angle_deg=180.0), 0.036, H),
     "thf45": lambda: tube_mesh(thf_centerline(45.0), 0.036, H),
+    "thf30-180": lambda: tube_mesh(thf_centerline(30.0, flexure_angle_deg=180.0), 0.036, H),
     "3d": lambda: tube_mesh(Centerline([Straight(0.03, "fixed", "a"), Arc(0.05, 1.5, "mobile", "b", roll=0.8),
                                         Straight(0.04, "mobile", "c"), Kink(0.7, roll=-1.2),
                                         Straight(0.05, "fixed", "d")], fillet_radius=0.04), 0.03, H),
@@ -94,7 +96,7 @@ def test_arc_tube_volume_follows_pappus():
     assert enclosed_volume(mesh) == pytest.approx(expected, rel=0.5 * (ds / radius) ** 2)
 
 
-@pytest.mark.parametrize("name", ["rsj36", "rsf45", "thf45"])
+@pytest.mark.parametrize("name", ["rsj36", "rsf45", "rsf45-180", "thf45", "thf30-180"])
 def test_rings_lie_in_normal_planes_without_twist(name):
     mesh = MESHES[name]()
     centre, t, _, _ = mesh.centerline.frame(mesh.s)
@@ -112,22 +114,31 @@ def test_tags_and_end_rings():
     s0, s1 = mesh.centerline.bounds("sigmoid")
     last = mesh.ring == mesh.n_rings - 1
     assert np.array_equal(mesh.end_ring, (mesh.ring == 0) | last)
-    # RSJ: mobile = sigmoid rings, except the last ring which is an (always fixed) end ring
-    assert np.array_equal(mesh.mobile, (mesh.s >= s0) & ~last)
+    # RSJ: mobile = the sigmoid's rings; the rectum's and the fixed exit's (the last, an end ring, among them) are held
+    assert np.array_equal(mesh.mobile, (mesh.s >= s0) & (mesh.s < s1))
+    assert mesh.s.max() > s1 + 0.09  # the exit's rings are there
     assert np.array_equal(mesh.fixed, ~mesh.mobile)
     assert not np.any(mesh.mobile & mesh.end_ring)
     rsf = MESHES["rsf45"]()
     names = np.array([p.name for p in rsf.centerline.pieces])[rsf.piece]
     # the sigmoid and the mobile halves of the fillets at its ends
     assert set(names[rsf.mobile]) == {"sigmoid", "rectum-sigmoid fillet", "sigmoid-descending fillet"}
+    assert names[-1] == "transverse" and not rsf.mobile[names == "transverse"].any()
+    thf = MESHES["thf45"]()
+    names = np.array([p.name for p in thf.centerline.pieces])[thf.piece]
+    # THF: the entry ring is an end ring (held); every other transverse ring is mobile, the rest held
+    assert np.array_equal(thf.mobile, (names == "transverse") & ~thf.end_ring)
+    assert names[0] == "transverse" and names[-1] == "ascending"
     assert not tube_mesh(thf_fixed_centerline(30.0), 0.036, H).mobile.any()
 
 
-SOURCE = {  # SPEC.md 2.1: the source's colon meshes (nodes, triangles)
+SOURCE = {  # the source's colon meshes (nodes, triangles; None: not given)
     "RSJ D23": (rsj_centerline, 0.023, 2064, 4076),
     "RSJ D36": (rsj_centerline, 0.036, 2792, 5504),
     "RSF alpha 0": (lambda: rsf_centerline(0.0), 0.036, 6632, 13188),
     "THF beta 0": (lambda: thf_centerline(0.0), 0.036, 4086, 7832),
+    "THF beta 30": (lambda: thf_centerline(30.0), 0.036, 5324, None),
+    "THF beta 45": (lambda: thf_centerline(45.0), 0.036, 5977, None),
 }
 
 
@@ -140,9 +151,10 @@ def test_mesh_sizes_next_to_the_source(name):
     rings = int(round(mesh.centerline.length / (np.pi * d / m * np.sqrt(3) / 2))) + 1
     assert summary["nodes"] == m * rings and summary["triangles"] == 2 * m * (rings - 1)
     print(f"{name}: {summary['nodes']} nodes / {summary['triangles']} triangles "
-          f"(source {src_nodes} / {src_tris}), centerline {mesh.centerline.length * 100:.1f} cm")
-    # Same order of magnitude is the check: the source's centerline lengths, lead-ins and mesher
+          f"(source {src_nodes} / {src_tris or '?'}), centerline {mesh.centerline.length * 100:.1f} cm")
+    # Same order of magnitude is the check: the source's centerline lengths, exits and mesher
     # (unstructured, unknown target size) are not known, and THF's diameter there is unknown.
+    # (The colon models' exact counts are pinned in tests/test_colon_segments.py.)
     assert 0.5 < summary["nodes"] / src_nodes < 2.0
 
 

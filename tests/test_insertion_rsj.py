@@ -1,9 +1,10 @@
-"""RSJ insertions (SPEC.md 2.5) at reduced size: scope ordering and the run's own checks.
+"""RSJ insertions at reduced size: scope ordering, the junction with the fixed exit, the run's own checks.
 
-CI runs a 4 mm wall mesh (COLONSIM_FULL=1: the 3 mm of the study). The numbers compared with
-the source live in the validation benchmark, not here: this checks what must hold whatever the
-calibration of the model (a stiffer scope deforms the colon more, the run ends with the tip past
-the fixed end, the colon's motion stays quasi-static).
+CI runs a 4 mm wall mesh for the scope comparison (COLONSIM_FULL=1: the 3 mm of the study); the
+junction test runs the default 3 mm mesh, on which the standard scope of the source's mesh used to
+jam. The numbers compared with the source live in the validation report, not here: this checks
+what must hold whatever the calibration of the model (a stiffer scope deforms the colon more, the
+tip passes into the fixed exit, the colon's motion stays quasi-static).
 """
 
 import os
@@ -11,7 +12,8 @@ import os
 import numpy as np
 import pytest
 
-from insertion.scenario import InsertionCase, run_insertion, tip_passed_end
+from insertion.colon_segments import PAST_JUNCTION
+from insertion.scenario import InsertionCase, run_insertion
 
 SIZE_MM = 3.0 if os.environ.get("COLONSIM_FULL") == "1" else 4.0
 
@@ -22,6 +24,14 @@ def rsj_runs():
             for scope in ("utc", "sdc")}
 
 
+@pytest.fixture(scope="module")
+def junction_run():
+    """The source's standard scope (13.3 mm) in the D = 36 mm RSJ on the default mesh: before the
+    fixed wall pushed along its own normal, its tip stuck in the crease between the bulged sigmoid
+    and the held ring 5 mm before the junction, and the push force climbed to hundreds of newtons."""
+    return run_insertion(InsertionCase(segment="rsj", scope="13.3", diameter_mm=36.0))
+
+
 @pytest.mark.slow
 def test_standard_scope_deforms_more_than_ultrathin(rsj_runs):
     utc, sdc = (rsj_runs[s].summary for s in ("utc", "sdc"))
@@ -29,23 +39,43 @@ def test_standard_scope_deforms_more_than_ultrathin(rsj_runs):
     assert sdc["peak_contact_force_N"] > utc["peak_contact_force_N"] > 0.0
 
 
+def _tip_and_exit(run):
+    """Tip position and the exit's axis (a point on it and its direction), m."""
+    g, rod = run.model.geometry, run.model.rod
+    tip = run.model.solver.state[rod.name].x[rod.tip_node]
+    s_junction = g.mobile_end
+    p0, p1 = g.centerline_points([s_junction, g.centerline_length])
+    return tip, p0, (p1 - p0) / np.linalg.norm(p1 - p0)
+
+
+def _check_passed_into_exit(run):
+    s = run.summary
+    assert s["ended_by"] == "tip_past_end", s["end"]
+    tip, p0, axis = _tip_and_exit(run)
+    along = np.dot(tip - p0, axis)
+    # the run ends at the first check (every 10 ms) after the tip crosses the plane 2 cm past the
+    # junction; a tip held back at the junction snaps forward when it slips in (measured: 1.1 cm
+    # beyond the plane for the 13.3 mm scope), so allow 2 cm
+    assert PAST_JUNCTION <= along <= PAST_JUNCTION + 0.02
+    # inside the fixed lumen: the tip's centre within D/2 less the scope radius of the exit's axis
+    lateral = np.linalg.norm(tip - p0 - along * axis)
+    assert lateral < 0.5 * (run.case.diameter_mm * 1e-3 - run.model.scope.diameter) + 1e-3
+    # no jam on the way, and the push stayed moderate (the jam climbed past 100 N)
+    assert s["peak_push_force_N"] < 50.0
+
+
+def test_standard_scope_passes_the_junction_on_the_default_mesh(junction_run):
+    _check_passed_into_exit(junction_run)
+    pts = junction_run.summary["points_cm"]
+    assert all(pts[p] is not None for p in "ABC")
+
+
 @pytest.mark.slow
-def test_runs_end_past_the_fixed_end_and_stay_quasi_static(rsj_runs):
-    # a scope either passes through the fixed end ring or jams against the bulged wall just before
-    # it, and then the push cap ends the run (which one happens depends on the mesh: at 3 mm the
-    # UTC passes, at 4 mm it jams); no scope crosses the end plane outside the ring
+def test_runs_pass_into_the_exit_and_stay_quasi_static(rsj_runs):
     for r in rsj_runs.values():
+        _check_passed_into_exit(r)
         s = r.summary
-        g, rod = r.model.geometry, r.model.rod
-        tip = r.model.solver.state[rod.name].x[rod.tip_node]
-        centre = g.nodes[g.end_ring & (g.nodes[:, 0] < -0.05)].mean(axis=0)
-        if s["ended_by"] == "the tip passed the fixed end":
-            assert r.timeseries["tip_past_end_m"].iloc[-1] >= 0.0
-            assert np.hypot(tip[0] - centre[0], tip[2] - centre[2]) < 0.5 * r.case.diameter_mm * 1e-3
-        else:
-            assert s["ended_by"].startswith("push depth cap")
-            assert not any(tip_passed_end(row, r.model) for row in r.timeseries.to_dict("records"))
         assert s["quasi_static"]["fraction_below_10pct"]["colon"] > 0.5
-        assert s["quasi_static"]["holds_without_imposed_sliding"]
+        assert s["quasi_static"]["holds"]
         assert r.timeseries.notna().all().all()
         assert 1.0 < s["max_wall_stretch"] < 2.0

@@ -25,7 +25,7 @@ def test_the_push_reaches_the_far_end(straight_run):
     ts = straight_run.timeseries
     # the run ends once the tip crosses the far end ring's plane (x = 20 cm), checked every 10 ms
     # of simulated time (6 mm of push at 0.6 m/s)
-    assert straight_run.summary["ended_by"] == "the tip passed the fixed end"
+    assert straight_run.summary["ended_by"] == "far_end"
     assert 0.0 <= ts["tip_past_end_m"].iloc[-1] <= 0.0062
     # the tip follows the pushed end: a stiff rod in a sheath, no axial buckling
     assert 0.20 + ts["tip_past_end_m"].iloc[-1] == pytest.approx(ts["depth_m"].iloc[-1], abs=0.002)

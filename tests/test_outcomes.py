@@ -1,9 +1,10 @@
-"""Characteristic points and the quasi-static check on synthetic curves with known answers."""
+"""Characteristic points, the quasi-static check and the jam detector on synthetic curves with known answers."""
 
 import numpy as np
 import pytest
 
-from insertion.outcomes import characteristic_points, principal_stretches, quasi_static_fraction, sliding_kinetic_energy
+from insertion.outcomes import (JAM_PROGRESS, JAM_PUSH, characteristic_points, jammed, principal_stretches,
+                                quasi_static_fraction, sliding_kinetic_energy)
 
 
 def rsj_like(noise=0.0, seed=0):
@@ -67,3 +68,67 @@ def test_sliding_kinetic_energy_removes_only_the_tank_tread_motion():
     # a sideways velocity w on top of the sliding: 1/2 m w^2 exactly
     w = np.array([0.0, 0.0, 0.2])
     assert sliding_kinetic_energy(x, 0.6 * tangent + w, mass, 0.6) == pytest.approx(0.5 * 0.4 * 0.04, rel=1e-3)
+
+
+# Jam detector: 4 cm of push sampled every 0.05 mm; the window is the last 2 cm of push.
+PUSH = np.linspace(0.0, 0.04, 801)
+STUCK = np.minimum(PUSH, 0.01)  # the tip stops 1 cm in and stays there
+
+
+def test_jam_defaults():
+    assert JAM_PUSH == 0.02 and JAM_PROGRESS == 1e-3
+
+
+def test_tip_stopped_while_push_force_rises_is_a_jam():
+    force = 2.0 + 500.0 * np.maximum(PUSH - 0.01, 0.0)  # rises once the tip stops
+    assert jammed(PUSH, STUCK, force)
+    # the same force with the tip following the push is no jam
+    assert not jammed(PUSH, PUSH, force)
+
+
+def test_tip_stopped_while_push_force_falls_is_no_jam():
+    force = 20.0 - 500.0 * np.maximum(PUSH - 0.01, 0.0)  # e.g. the scope unloading into a loop
+    assert not jammed(PUSH, STUCK, force)
+    assert not jammed(PUSH, STUCK, np.full_like(PUSH, 5.0))  # a constant force does not rise either
+
+
+@pytest.mark.parametrize("advance, jam", [(2e-3, False), (0.5e-3, True)])
+def test_tip_progress_over_the_window_against_the_threshold(advance, jam):
+    # the tip creeps forward by `advance` over the last 2 cm of push (threshold: 1 mm)
+    arc = 0.01 + advance * np.clip((PUSH - 0.02) / 0.02, 0.0, 1.0)
+    force = 2.0 + 100.0 * PUSH
+    assert jammed(PUSH, arc, force) is jam
+    # a looser threshold turns the 2 mm creep into a jam too
+    assert jammed(PUSH, arc, force, progress=3e-3)
+
+
+@pytest.mark.parametrize("pushed, jam", [(0.015, False), (0.019, False), (0.025, True)])
+def test_too_little_push_recorded_is_no_jam(pushed, jam):
+    # stuck from the start, force rising: a jam only once a whole window (2 cm) of push is on record
+    z = np.linspace(0.0, pushed, 301)
+    assert jammed(z, np.zeros_like(z), 1.0 + 100.0 * z) is jam
+
+
+def test_constant_depth_is_no_jam():
+    # the relax phase: no push, the tip at rest, the force creeping up as the wall settles
+    z = np.full(200, 0.03)
+    assert not jammed(z, np.full(200, 0.01), np.linspace(5.0, 6.0, 200))
+    # pushed 3 cm with the tip following, then held: the window (the last 2 cm of push) saw the tip advance
+    z = np.r_[np.linspace(0.0, 0.03, 601), np.full(200, 0.03)]
+    force = np.r_[np.full(601, 2.0), np.linspace(2.0, 4.0, 200)]
+    assert not jammed(z, np.minimum(z, 0.03), force)
+
+
+@pytest.mark.parametrize("trend, jam", [(50.0, True), (-50.0, False)])
+def test_ringing_force_is_judged_by_its_half_window_means(trend, jam):
+    """The drive reaction rings: 5 N at a period of 2/21 cm of push (10.5 periods in the window), on a
+    trend of +-50 N/m (+-0.5 N between the half-window means; the ringing's own means differ by 0.3 N)."""
+    period = 0.02 / 10.5
+    force = 20.0 + trend * (PUSH - 0.02) + 5.0 * np.cos(2 * np.pi * (PUSH - 0.02) / period)
+    window = PUSH >= 0.02 - 1e-12
+    f = force[window]
+    # sample by sample the force goes up and down, and the rising case even ends below where the window began
+    assert np.mean(np.diff(f) < 0) > 0.4 and f[-1] < f[0]
+    half = PUSH[window] > 0.03
+    assert bool(f[half].mean() > f[~half].mean()) is jam  # the means carry the trend
+    assert jammed(PUSH, STUCK, force) is jam
