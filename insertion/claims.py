@@ -1,4 +1,4 @@
-"""The source's claims (SPEC.md 2.5) evaluated on a sweep results table.
+"""The source's claims (docs/model.md, "Reference results") evaluated on a sweep results table.
 
 Each function takes the table of :mod:`insertion.sweep` (one row per run: ``segment``, ``scope``,
 ``diameter_mm``, ``friction``, ``angle_deg``, ``point_A_cm``, ``point_C_cm``,
@@ -8,6 +8,10 @@ Each function takes the table of :mod:`insertion.sweep` (one row per run: ``segm
 - ``NOT REPRODUCED``: every run is there and at least one comparison fails (``reason`` says which);
 - ``NOT EVALUATED``: a run the criterion needs is missing or failed (``missing`` lists them);
   nothing is guessed from the runs that are there.
+
+A run's scope is UTC, PDC or SDC by name, or by its ``scope_diameter_mm`` when that is a
+catalogue or a source-mesh diameter (:func:`insertion.scopes.scope_role`), so the source's
+meshed scopes (9.2 / 11.1 / 13.3 mm) count as its UTC / PDC / SDC.
 
 The criterion of each claim is stated in ``ClaimResult.criterion``; the thresholds that make a
 vague claim testable ("little", "large") are keyword arguments with their defaults documented.
@@ -21,6 +25,7 @@ import numpy as np
 import pandas as pd
 
 from colonsim.errors import ColonsimError
+from insertion.scopes import scope_role
 
 REPRODUCED = "REPRODUCED"
 NOT_REPRODUCED = "NOT REPRODUCED"
@@ -31,7 +36,7 @@ FRICTIONS = (0.0, 0.05, 0.1)
 RSJ_DIAMETERS = (23.0, 36.0)
 ANGLES = (0.0, 30.0, 45.0)
 # Below this the standard scope barely deforms the colon: no relative advantage can be read from
-# it. 1 mm is a third of the 3 mm wall mesh (SPEC.md 2.1); the source's deformations are 1.3 cm and up.
+# it. 1 mm is a third of the 3 mm wall mesh; the source's deformations are 1.3 cm and up.
 NO_DEFORMATION_CM = 0.1
 
 
@@ -58,12 +63,17 @@ class _Runs:
     def __init__(self, table: pd.DataFrame):
         self.table = table
         self.missing = []
+        names = table["scope"].astype(str).str.lower()
+        if "scope_diameter_mm" in table:
+            by_size = table["scope_diameter_mm"].astype(float).map(scope_role)
+            names = names.where(names.isin(("utc", "pdc", "sdc")), by_size)
+        self._roles = names
 
     def value(self, column, segment, scope, **inputs):
         """``column`` of the one ok run matching the inputs (floats compared with a tolerance);
         None (recorded as missing) when there is no such run or it failed."""
         t = self.table
-        mask = (t["segment"].astype(str).str.lower() == segment) & (t["scope"].astype(str).str.lower() == scope)
+        mask = (t["segment"].astype(str).str.lower() == segment) & (self._roles == scope)
         for name, value in inputs.items():
             mask &= np.isclose(t[name].astype(float), float(value), rtol=0.0, atol=1e-9)
         rows = t[mask]
@@ -244,7 +254,7 @@ def rsj_ordering(table, diameters=RSJ_DIAMETERS, friction=0.0) -> ClaimResult:
     runs = _Runs(table)
     result = ClaimResult(
         "rsj_ordering",
-        "RSJ (SPEC.md 2.5 table, mu = 0): SDC > PDC > UTC at point A and at point C, and C > A in every case.",
+        "RSJ (the source's table, mu = 0): SDC > PDC > UTC at point A and at point C, and C > A in every case.",
         f"At mu = {friction:g}, for each D in {_list(diameters, ' mm')}: deformation at A of SDC > PDC > UTC, the same "
         "at C, and for each of the six runs C > A. A run without a point A (a deformation curve with no first "
         "maximum followed by a minimum) fails the comparisons that need A.", NOT_EVALUATED)
@@ -274,7 +284,7 @@ def rsj_ordering(table, diameters=RSJ_DIAMETERS, friction=0.0) -> ClaimResult:
 
 
 def evaluate_claims(table) -> list[ClaimResult]:
-    """Every claim of SPEC.md 2.5, in the order of the spec."""
+    """Every claim of the source, in the order it states them."""
     return [sc_deform_less_rsj(table), reduction_larger_at_small_diameter(table), sc_less_friction_sensitive(table),
             angle_dependence(table, "rsf"), angle_dependence(table, "thf"), rsj_ordering(table)]
 

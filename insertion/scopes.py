@@ -1,4 +1,4 @@
-"""Colonoscopes of the study (SPEC.md 2.2): named scopes or any diameter, as rods.
+"""Colonoscopes of the study (docs/model.md, "Colonoscope"): named scopes or any diameter, as rods.
 
 The scope is a slender linear-elastic cylinder, E = 16 MPa (from the flexural rigidity of a
 3-point bending test), density 2944 kg/m^3, Poisson 0.3 (only used to report the shear modulus:
@@ -18,12 +18,22 @@ from insertion.rod import Rod
 SCOPE_YOUNGS_MODULUS = 16e6  # Pa
 SCOPE_DENSITY = 2944.0  # kg/m^3
 SCOPE_POISSON = 0.3
-# SPEC.md 2.2; "small caliber" = UTC and PDC.
+# Catalogue diameters, as the source's introduction and results name them; "small caliber" = UTC and PDC.
 NAMED_SCOPES = {
     "utc": ("ultrathin colonoscope", 9.2e-3),
     "pdc": ("pediatric colonoscope", 11.3e-3),
     "sdc": ("standard colonoscope", 12.8e-3),
 }
+# The diameters the source's scope meshes had (its runs, and the runs that reproduce them).
+MESHED_DIAMETERS = {"utc": 9.2e-3, "pdc": 11.1e-3, "sdc": 13.3e-3}
+
+
+def scope_role(diameter_mm):
+    """``"utc"``, ``"pdc"`` or ``"sdc"`` for a catalogue or source-mesh diameter (mm), else None."""
+    for name, (_, catalogue) in NAMED_SCOPES.items():
+        if any(abs(diameter_mm - d * 1e3) < 0.05 for d in (catalogue, MESHED_DIAMETERS[name])):
+            return name
+    return None
 # Plausible range of an insertion tube's outer diameter, m: outside it a number is a unit slip.
 DIAMETER_RANGE = (3e-3, 20e-3)
 
@@ -45,7 +55,7 @@ class Colonoscope:
 
     @property
     def wave_speed(self):
-        """Axial wave speed sqrt(E / rho), m/s (about 74 m/s, SPEC.md 2.2)."""
+        """Axial wave speed sqrt(E / rho), m/s (about 74 m/s)."""
         return math.sqrt(self.youngs_modulus / self.density)
 
     @property

@@ -91,13 +91,13 @@ class SweepSurrogate:
             if varying_settings:
                 self.notes_.append(f"{segment}: solver setting(s) {', '.join(varying_settings)} vary between runs; "
                                    "they are not inputs, so their effect shows up as scatter")
-            # the literal SPEC check fails for every insertion (the scope's imposed push dominates its
-            # kinetic energy); the check without that imposed sliding is the informative one
+            # tables of older code hold the check without the scope's imposed sliding in its own column;
+            # today's "quasi_static" is that check
             check = next((c for c in ("quasi_static_without_imposed_sliding", "quasi_static") if c in runs.columns), None)
             if check is not None and (runs[check] == False).any():  # noqa: E712 (NaN-safe)
-                what = "KE/IE check without the scope's imposed sliding" if check != "quasi_static" else "KE/IE check"
                 self.notes_.append(f"{segment}: {int((runs[check] == False).sum())} of {len(runs)} runs "  # noqa: E712
-                                   f"were not quasi-static ({what}); they train like the others")
+                                   "were not quasi-static (KE/IE check without the scope's imposed sliding); "
+                                   "they train like the others")
             self.models_[segment], self.cv_[segment], self.skipped_[segment] = {}, {}, {}
             for target in self.targets:
                 y = runs[target].to_numpy(dtype=float)

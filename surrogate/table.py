@@ -31,8 +31,9 @@ TARGET_LABELS = {"final_deformation_cm": "final colon deformation [cm]", "max_de
                  "point_C_cm": "deformation at point C [cm]", "peak_contact_force_N": "peak contact force [N]",
                  "peak_push_force_N": "peak push force [N]", "max_wall_stretch": "maximum wall stretch"}
 # Columns that are neither inputs nor solver settings: identity and outputs of a run.
-NOT_SETTINGS = {"key", "status", "error", "wall_time_s", "timeseries_path", "finished_at", "segment", "scope",
-                "quasi_static", "quasi_static_without_imposed_sliding", "simulated_time_s", "point_B_cm", *INPUTS, *TARGET_LABELS}
+NOT_SETTINGS = {"key", "status", "error", "wall_time_s", "timeseries_path", "finished_at", "git_commit", "segment", "scope",
+                "quasi_static", "quasi_static_literal", "quasi_static_without_imposed_sliding", "ended_by", "end_depth_cm",
+                "end_push_force_N", "end_contact_force_N", "simulated_time_s", "point_B_cm", *INPUTS, *TARGET_LABELS}
 REQUIRED = ("status", "segment", "scope_diameter_mm")
 
 
