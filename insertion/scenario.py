@@ -227,13 +227,15 @@ def build_insertion(case: InsertionCase) -> Insertion:
 
 @dataclass
 class InsertionResult:
-    """Recorded time series (SI columns), the run's summary and optional snapshots."""
+    """Recorded time series (SI columns), the run's summary, optional snapshots and the final shape
+    (``{"colon_m": (n, 3), "scope_m": (k, 3)}`` node positions at the end of the run)."""
 
     case: InsertionCase
     timeseries: object  # pandas.DataFrame
     summary: dict
     snapshots: list
     model: Insertion
+    final_shape: dict | None = None
 
 
 def run_insertion(case: InsertionCase, progress=None, snapshot_interval=None, chunk_s=0.01) -> InsertionResult:
@@ -257,7 +259,7 @@ def run_insertion(case: InsertionCase, progress=None, snapshot_interval=None, ch
     ended_by = "length_used"
     while model.solver.time < duration - 1e-9:
         step = min(chunk_s, duration - model.solver.time)
-        model.solver.run(step, record_interval=case.record_interval_s, callbacks=[recorder])
+        model.solver.run(step, record_interval=case.record_interval_s, callbacks=[recorder], exact_end=False)
         if not recorder.rows or recorder.rows[-1]["time_s"] < model.solver.time:
             recorder(model.solver)  # the state at the end of every chunk is a sample
         last = recorder.rows[-1]
@@ -274,7 +276,8 @@ def run_insertion(case: InsertionCase, progress=None, snapshot_interval=None, ch
     summary = summarize(model, frame, wall, t0 - t_build)
     summary["ended_by"] = ended_by
     summary["end"] = end_state(model, frame, ended_by)
-    return InsertionResult(case, frame, summary, recorder.snapshots, model)
+    final = {"colon_m": model.solver.state["colon"].x.copy(), "scope_m": model.solver.state[model.rod.name].x.copy()}
+    return InsertionResult(case, frame, summary, recorder.snapshots, model, final)
 
 
 ENDINGS = {
