@@ -6,6 +6,8 @@ Layout of a run folder::
                      contact and push force [N], kinetic/internal energy per body [J], ...
     summary.json     final/max deformation, points A/B/C, peak forces, quasi-static check, inputs
     insertion.png    deformation vs depth, forces, energy ratio, tip displacement
+    final_shape.npz  wall and scope node positions at the end of the run, m (``colon_m``, ``scope_m``;
+                     read with :func:`read_final_shape`; the rest shape follows from the inputs)
     vtu/             colon_NNNN.vtu, scope_NNNN.vtu (+ .pvd collections) with --vtu
 """
 
@@ -13,6 +15,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import numpy as np
 import pandas as pd
 from matplotlib.figure import Figure
 
@@ -122,7 +125,17 @@ def write_insertion(result, out_dir, vtu=False) -> dict:
     write_csv(paths["timeseries"], user_units(result.timeseries))
     write_json(paths["summary"], result.summary)
     save_figure(insertion_figure([result]), paths["plot"])
+    if getattr(result, "final_shape", None) is not None:
+        paths["final_shape"] = out / "final_shape.npz"
+        with atomic_path(paths["final_shape"]) as tmp:
+            np.savez_compressed(tmp, **result.final_shape)
     if vtu:
         write_vtu_series(result, out / "vtu")
         paths["vtu"] = out / "vtu"
     return paths
+
+
+def read_final_shape(out_dir) -> dict:
+    """The final wall and scope node positions of a run folder (m), without unpickling anything."""
+    with np.load(Path(out_dir) / "final_shape.npz", allow_pickle=False) as data:
+        return {name: data[name] for name in data.files}

@@ -5,7 +5,7 @@ Output folder::
     results.parquet     one row per run (columns: :data:`IDENTITY`, every InsertionCase field,
                         ``scope_diameter_mm``, :data:`OUTPUTS`); rewritten atomically after each run
     sweep.json          the sweep that was last run here (name, seed, keys, TOML text)
-    runs/<key>/         timeseries.csv, summary.json, insertion.png of each successful run
+    runs/<key>/         timeseries.csv, summary.json, insertion.png, final_shape.npz of each successful run
 
 A run is identified by :meth:`InsertionCase.key` (a hash of every input). Rerunning a sweep into
 the same folder skips the keys already in the table, so a killed sweep loses at most the runs
@@ -170,7 +170,8 @@ class SweepStore:
             from insertion.results import write_insertion
 
             folder = Path("runs") / case.key()
-            result = InsertionResult(case, outcome["timeseries"], outcome["summary"], snapshots=[], model=None)
+            result = InsertionResult(case, outcome["timeseries"], outcome["summary"], snapshots=[], model=None,
+                                     final_shape=outcome.get("final_shape"))
             written = write_insertion(result, self.folder / folder)
             path = (folder / written["timeseries"].name).as_posix()
         row = result_row(case, outcome, path)

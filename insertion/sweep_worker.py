@@ -81,7 +81,8 @@ def execute(case, runner=None) -> dict:
     -------
     dict
         ``key``, ``status`` ("ok" | "failed"), ``error``, ``wall_time_s``, ``finished_at``, and for
-        ok runs ``summary`` and ``timeseries`` (SI DataFrame), which the client writes.
+        ok runs ``summary``, ``timeseries`` (SI DataFrame) and ``final_shape`` (node positions at
+        the end, or None), which the client writes.
     """
     prepare_worker()
     _one_thread()
@@ -90,7 +91,8 @@ def execute(case, runner=None) -> dict:
         t0 = time.perf_counter()
         try:
             result = runner(case)
-            outcome = {"status": "ok", "error": "", "summary": result.summary, "timeseries": result.timeseries}
+            outcome = {"status": "ok", "error": "", "summary": result.summary, "timeseries": result.timeseries,
+                       "final_shape": getattr(result, "final_shape", None)}
         except Exception as exc:  # a failed run is a result too; the sweep goes on
             message = " ".join(str(exc).split()) or "(no message)"
             outcome = {"status": "failed", "error": f"{type(exc).__name__}: {message}"}
