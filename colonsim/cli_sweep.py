@@ -19,11 +19,12 @@ def add_parser(sub):
     """Add the ``sweep`` subcommand to the subparsers ``sub`` of :func:`colonsim.cli.build_parser`."""
     p = sub.add_parser("sweep", help="run insertions over scopes, anatomies and friction (resumable)",
                        description="Run the insertion model over a grid and/or Latin hypercube of inputs "
-                                   "(SPEC.md 3), described in a TOML file (format: docs/sweeps.md) or a preset. "
+                                   "(docs/sweeps.md), described in a TOML file (format: docs/sweeps.md) or a preset. "
                                    "Writes results.parquet (one row per run) and runs/<key>/ per run. Rerunning "
                                    "into the same --out skips the runs already finished.")
     p.add_argument("spec", nargs="?", type=Path, help="sweep TOML file")
-    p.add_argument("--preset", help="thesis (the source's 39 insertions) or smoke (3 fast runs)")
+    p.add_argument("--preset", help="thesis (the source's 39 insertions), validation (the validation report's "
+                                    "16 extra runs) or smoke (3 fast runs)")
     p.add_argument("--workers", type=int, default=None,
                    help=f"local worker processes, one Numba thread each (default: the cores, {available_cores()} here)")
     p.add_argument("--scheduler", metavar="ADDR",

@@ -19,13 +19,33 @@ def test_thesis_preset_holds_every_case_of_chapter_v():
     cases = load_sweep(preset="thesis").cases
     by_segment = {s: [c for c in cases if c.segment == s] for s in ("rsj", "rsf", "thf", "thf-fixed")}
     assert len(cases) == 39 and len({c.key() for c in cases}) == 39
+    meshed = ("9.2", "11.1", "13.3")  # the source's scope meshes, not the catalogue's 9.2 / 11.3 / 12.8 mm
     rsj = {(c.scope, c.diameter_mm, c.friction) for c in by_segment["rsj"]}
-    assert rsj == {(s, d, mu) for s in ("utc", "pdc", "sdc") for d in (23.0, 36.0) for mu in (0.0, 0.05, 0.1)}
+    assert rsj == {(s, d, mu) for s in meshed for d in (23.0, 36.0) for mu in (0.0, 0.05, 0.1)}
     for segment in ("rsf", "thf"):
         assert {(c.scope, c.angle_deg) for c in by_segment[segment]} == {
-            (s, a) for s in ("utc", "pdc", "sdc") for a in (0.0, 30.0, 45.0)}
+            (s, a) for s in meshed for a in (0.0, 30.0, 45.0)}
         assert all(c.friction == 0 and c.diameter_mm == 36 for c in by_segment[segment])
-    assert {c.scope for c in by_segment["thf-fixed"]} == {"utc", "pdc", "sdc"}
+    assert {c.scope for c in by_segment["thf-fixed"]} == set(meshed)
+    assert all(c.flexure_angle_deg == 90.0 and c.exit_length_mm == 100.0 for c in cases)
+
+
+def test_validation_preset_pairs_each_model_with_the_thesis_runs():
+    """Each validation run differs from a thesis run in exactly one input: the mesh, the push speed
+    or the flexure angle, so the report can pair them."""
+    thesis = {c.key(): c for c in load_sweep(preset="thesis").cases}
+    cases = load_sweep(preset="validation").cases
+    assert len(cases) == 16 and len({c.key() for c in cases}) == 16
+    changes = {}
+    for c in cases:
+        base = {"element_size_mm": 3.0, "push_speed": 0.6, "flexure_angle_deg": 90.0}
+        varied = [k for k, v in base.items() if getattr(c, k) != v]
+        assert len(varied) == 1
+        partner = InsertionCase(**{**c.to_dict(), varied[0]: base[varied[0]]})
+        assert partner.key() in thesis
+        changes.setdefault(varied[0], set()).add(c.segment)
+    assert changes["element_size_mm"] == changes["push_speed"] == {"rsj", "rsf", "thf", "thf-fixed"}
+    assert changes["flexure_angle_deg"] == {"rsf", "thf"}
 
 
 def test_smoke_preset_is_small_and_coarse():
