@@ -3,7 +3,7 @@
 A centerline is a chain of pieces, each tagged ``"fixed"`` (retroperitoneal, held in place) or
 ``"mobile"`` (intraperitoneal) and named after its colon segment. Pieces are given as
 :class:`Straight`, :class:`Arc` and :class:`Kink`; a kink between two straight pieces becomes a
-fillet arc of radius ``fillet_radius`` (**assumption** of SPEC.md 2.1, so the tube has no crease),
+fillet arc of radius ``fillet_radius`` (**assumption**, docs/model.md "Colon models", so the tube has no crease),
 trimming ``R_f tan(|angle|/2)`` off each neighbour.
 
 Fillet rule (**assumption**): a fillet between two pieces of the same tag takes that tag; between
@@ -22,7 +22,7 @@ positive angle towards ``+n``), which is how a 3-D centerline is built.
 
 The model builders (:func:`rsj_centerline`, :func:`rsf_centerline`, :func:`thf_centerline`,
 :func:`thf_fixed_centerline`) are planar in the x-y plane, start at the origin heading ``+y`` with
-``n = -x`` (positive turns are counter-clockwise seen from ``+z``). Readings of SPEC.md 2.1
+``n = -x`` (positive turns are counter-clockwise seen from ``+z``). Readings of the source
 (**assumptions**) are in their docstrings.
 """
 
@@ -34,7 +34,7 @@ import numpy as np
 
 from colonsim.errors import ColonsimError
 
-FLEXURE_RADIUS = 0.05  # m, SPEC.md 2.1 (flexures and the RSJ sigmoid arc)
+FLEXURE_RADIUS = 0.05  # m, the source's bend radius (flexures and the RSJ sigmoid arc)
 FILLET_RADIUS = 0.05  # m, assumption: same as the flexures, the gentlest bend the anatomy shows
 MAX_LENGTH = 2.0  # m, a whole adult colon is about 1.5 m; longer pieces are typing errors
 TAGS = ("fixed", "mobile")

@@ -5,7 +5,7 @@ rotated by half a node spacing, so the triangles are close to equilateral with e
 (on a bend they are compressed on the inner side and stretched on the outer side by ``1 -/+ D/(2R)``).
 Rings are placed in the centerline's parallel-transport frame, so the mesh does not twist and a
 node keeps its angular position along the tube. Node tags come from the centerline pieces; the
-first and last ring are the end rings, held fixed in every model (SPEC.md 2.1).
+first and last ring are the end rings, held fixed in every model (docs/model.md, "Colon models").
 
 ``diameter`` is the diameter of the meshed surface: pass the lumen diameter D for a contact
 surface, or D + t for the wall's mid-surface of a shell of thickness t.

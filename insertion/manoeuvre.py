@@ -1,13 +1,14 @@
-"""The insertion manoeuvre (SPEC.md 2.3): a smooth push-speed profile and its phases.
+"""The insertion manoeuvre (docs/model.md, "Loading"): a smooth push-speed profile and its phases.
 
 The proximal end of the scope is driven at a prescribed speed along the sheath axis. The speed
 profile is piecewise constant with (1 - cos) transitions of duration ``ramp`` between levels, so
 the scope is never jerked (a step in speed launches an axial wave of amplitude rho c A dv).
 
 - RSJ: one continuous push.
-- RSF, THF (**assumption** on the exact profile, as SPEC.md states): push with the mobile part's
-  lateral motion constrained until the tip reaches the flexure ("straighten"), slow to a stop and
-  let the system relax while the constraint is released ("birth and death"), then push through.
+- RSF, THF (**assumption** on the exact profile): push with the mobile part's lateral motion
+  constrained until the pushed depth reaches the end of the mobile part ("straighten"), slow to a
+  stop and let the system relax while the constraint is released ("birth and death"), then push
+  on through the flexure.
 """
 
 from __future__ import annotations

@@ -1,4 +1,4 @@
-"""Scalar outcomes of an insertion from its time series (SPEC.md 2.3-2.4).
+"""Scalar outcomes of an insertion from its time series (docs/model.md, "Outputs").
 
 Plain functions of recorded arrays, so they apply equally to a fresh run and to a CSV read back.
 """
@@ -10,7 +10,7 @@ from scipy.signal import find_peaks
 
 
 def characteristic_points(time, depth, deformation, prominence=0.05):
-    """Points A, B, C of an RSJ deformation curve (SPEC.md 2.4).
+    """Points A, B, C of an RSJ deformation curve (docs/model.md, "Outputs").
 
     A is the first maximum (the tip negotiating the angulation), B the minimum that follows, C
     the maximum after B (the tip passing the fixed end). A maximum counts only if it stands out

@@ -1,14 +1,15 @@
-"""The source's reference numbers (SPEC.md 2.5: LS-DYNA results of the source's Chapter V).
+"""The source's reference numbers: LS-DYNA results of its Chapter V (X. He, MSc thesis, University of
+Minnesota, 2018; docs/model.md, "Reference results").
 
-Constants copied from SPEC.md 2.5; nothing here is computed by this project.
+Constants copied from the source; nothing here is computed by this project.
 """
 
 from __future__ import annotations
 
 import pandas as pd
 
-# SPEC.md 2.5: RSJ colon deformation (cm) at points A and C, mu = 0, per (scope, colon diameter mm).
-# The source's final deformation equals the value at C (SPEC.md 2.4).
+# RSJ colon deformation (cm) at points A and C, mu = 0, per (scope, colon diameter mm).
+# The source's final deformation equals the value at C.
 SOURCE_RSJ_CM = {
     ("utc", 23.0): {"A": 1.353, "C": 2.575},
     ("utc", 36.0): {"A": 1.319, "C": 2.389},
@@ -18,7 +19,7 @@ SOURCE_RSJ_CM = {
     ("sdc", 36.0): {"A": 2.651, "C": 3.824},
 }
 
-# SPEC.md 2.5: run time of one insertion, minutes (LS-DYNA 17, 4-core i7-4600U laptop).
+# Run time of one insertion, minutes (LS-DYNA 17, 4-core i7-4600U laptop).
 SOURCE_RUN_MINUTES = {
     ("rsj", "utc"): 50, ("rsj", "pdc"): 78, ("rsj", "sdc"): 100,
     ("rsf", "utc"): 150, ("rsf", "pdc"): 240, ("rsf", "sdc"): 380,

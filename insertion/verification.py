@@ -24,11 +24,11 @@ from insertion.shell import Shell, dihedral_angles
 from insertion.solver import ExplicitSolver, FixedNodes, LineConstraint, NodalLoad, PrescribedVelocity
 from insertion.statics import minimize_energy
 
-# The standard scope of SPEC.md 2.2.
+# The standard scope (catalogue diameter).
 SCOPE_E = 16e6  # Pa
 SCOPE_RHO = 2944.0  # kg/m^3
 SCOPE_D = 12.8e-3  # m
-WALL_T = 2e-3  # m, wall thickness (SPEC.md 2.1 assumption)
+WALL_T = 2e-3  # m, wall thickness (an assumption, docs/model.md)
 
 
 @dataclass(frozen=True)
