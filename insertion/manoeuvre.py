@@ -6,9 +6,9 @@ the scope is never jerked (a step in speed launches an axial wave of amplitude r
 
 - RSJ: one continuous push.
 - RSF, THF (**assumption** on the exact profile): push with the mobile part's lateral motion
-  constrained until the pushed depth reaches the end of the mobile part ("straighten"), slow to a
-  stop and let the system relax while the constraint is released ("birth and death"), then push
-  on through the flexure.
+  constrained until the pushed depth reaches the end of the mobile part ("straighten", "stop"),
+  let the system relax at rest with the constraint released ("birth and death"), then push on
+  through the flexure.
 """
 
 from __future__ import annotations
@@ -74,6 +74,12 @@ class PushProfile:
         """Insertion depth (distance pushed) at time ``t``, m."""
         return sum(dv * _transition(t - t0, self.ramp)[1] for t0, dv in self._levels)
 
+    @property
+    def lateral_constraint_end(self):
+        """End of the last phase that holds the mobile part laterally, s (None: no such phase)."""
+        ends = [p.end for p in self.phases if p.lateral_constraint]
+        return ends[-1] if ends else None
+
     def phase_at(self, t):
         for p in self.phases:
             if p.start <= t < p.end:
@@ -93,20 +99,26 @@ def continuous_push(depth, speed=0.6, ramp=0.05) -> PushProfile:
 
 
 def straighten_relax_push(straighten_depth, depth, speed=0.6, ramp=0.05, relax=0.1) -> PushProfile:
-    """RSF/THF: push to ``straighten_depth`` with the lateral constraint, stop and relax for
-    ``relax`` seconds with the constraint released, then push on to ``depth`` (m)."""
+    """RSF/THF: push to ``straighten_depth`` with the lateral constraint, slow to a stop there with
+    it still on, relax for ``relax`` seconds with it released, then push on to ``depth`` (m).
+
+    Phases: ``straighten`` (at speed) and ``stop`` (the slow-down ramp, ending at rest at
+    ``straighten_depth``) hold the mobile part (``lateral_constraint``); ``relax`` and ``push`` do not.
+    """
     _check(depth, speed, ramp)
     if not 0.0 < straighten_depth < depth:
         raise ColonsimError(f"straightening depth {straighten_depth:.3g} m must lie between 0 and the total depth {depth:.3g} m")
-    if relax < ramp:
-        raise ColonsimError(f"relax time {relax} s must be at least the ramp {ramp} s (the scope must come to rest)")
+    if not (np.isfinite(relax) and relax > 0.0):
+        raise ColonsimError(f"relax time {relax!r} s must be positive (the scope must come to rest)")
     # Slowing down from the plateau covers speed * ramp / 2, like speeding up.
     t1 = _time_to_push(straighten_depth, speed, ramp) - 0.5 * ramp
-    t2 = t1 + relax
-    t3 = t2 + _time_to_push(depth - straighten_depth, speed, ramp)
+    t2 = t1 + ramp
+    t3 = t2 + relax
+    t4 = t3 + _time_to_push(depth - straighten_depth, speed, ramp)
     return PushProfile([Phase("straighten", 0.0, t1, speed, lateral_constraint=True),
-                        Phase("relax", t1, t2, 0.0),
-                        Phase("push", t2, t3, speed)], ramp)
+                        Phase("stop", t1, t2, 0.0, lateral_constraint=True),
+                        Phase("relax", t2, t3, 0.0),
+                        Phase("push", t3, t4, speed)], ramp)
 
 
 def _check(depth, speed, ramp):

@@ -126,7 +126,7 @@ class InsertionCase:
             ("record_interval_s", self.record_interval_s, 1e-6, 1.0, "recording interval in s"),
             ("time_step_factor", self.time_step_factor, 0.01, 1.0, "a safety factor in (0, 1]"),
             ("ramp_s", self.ramp_s, 0.0, 10.0, "ramp duration in s"),
-            ("relax_s", self.relax_s, 0.0, 10.0, "relax duration in s"),
+            ("relax_s", self.relax_s, 1e-3, 10.0, "relax duration in s (0.1 by default)"),
             ("exit_length_mm", self.exit_length_mm, 0.0, 300.0, "fixed exit length in mm (100 by default)"),
             ("flexure_angle_deg", self.flexure_angle_deg, 1.0, 180.0, "flexure turn in degrees (90 by default)"),
             ("sheath_reserve_mm", self.sheath_reserve_mm, 0.0, 200.0, "scope length kept in the sheath, mm (20)"),
@@ -199,7 +199,7 @@ def build_insertion(case: InsertionCase) -> Insertion:
         push = continuous_push(total_depth, case.push_speed, case.ramp_s)
     else:
         push = straighten_relax_push(geometry.straighten_depth, total_depth, case.push_speed, case.ramp_s,
-                                     max(case.relax_s, case.ramp_s))
+                                     case.relax_s)
 
     # tube meshes are oriented with normals out of the lumen: the fixed wall's rest normals
     contact = RodShellContact(rod, shell, friction=case.friction,
@@ -208,12 +208,12 @@ def build_insertion(case: InsertionCase) -> Insertion:
     constraints = [FixedNodes(shell, held)]
     mobile = np.flatnonzero(geometry.mobile & ~geometry.end_ring)
     if geometry.straighten_depth is not None:
-        straighten = push.phases[0]
+        held_until = push.lateral_constraint_end
         # Lateral motion of the mobile part blocked while straightening ("birth and death"):
         # each mobile node may only move along the axis of the straight piece it belongs to.
         for direction, nodes in geometry.mobile_axes:
             constraints.append(LineConstraint(shell, point=geometry.nodes[nodes[0]], direction=direction,
-                                              nodes=nodes, start=straighten.start, end=straighten.end))
+                                              nodes=nodes, start=0.0, end=held_until))
     drive = PrescribedVelocity(rod, [0], lambda t: push.speed(t) * axis)
     # The sheath: every scope node behind the entry plane moves only along the entry axis.
     sheath = LineConstraint(rod, point=entry, direction=axis, extent=(-math.inf, -0.5 * scope.diameter))

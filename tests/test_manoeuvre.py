@@ -21,15 +21,20 @@ def test_continuous_push_reaches_the_depth_smoothly():
 def test_straighten_relax_push_phases():
     p = straighten_relax_push(0.15, 0.40, speed=0.6, ramp=0.05, relax=0.1)
     names = [ph.name for ph in p.phases]
-    assert names == ["straighten", "relax", "push"]
-    straighten, relax, push = p.phases
-    assert straighten.lateral_constraint and not relax.lateral_constraint
-    # the scope is at rest at the straightening depth after the slow-down ramp
-    assert p.speed(relax.start + 0.05) == pytest.approx(0.0, abs=1e-12)
-    assert p.depth(relax.start + 0.05) == pytest.approx(0.15, rel=1e-12)
+    assert names == ["straighten", "stop", "relax", "push"]
+    straighten, stop, relax, push = p.phases
+    # the mobile part is held until the scope has come to rest at the straightening depth
+    assert straighten.lateral_constraint and stop.lateral_constraint
+    assert not relax.lateral_constraint and not push.lateral_constraint
+    assert p.lateral_constraint_end == stop.end == relax.start
+    assert p.speed(stop.end) == pytest.approx(0.0, abs=1e-12)
+    assert p.depth(stop.end) == pytest.approx(0.15, rel=1e-12)
+    # it rests there for the relax time, released, then the push goes on to the total depth
+    assert relax.end - relax.start == pytest.approx(0.1)
     assert p.depth(relax.end) == pytest.approx(0.15, rel=1e-12)
     assert p.depth(p.duration) == pytest.approx(0.40, rel=1e-12)
     assert p.phase_at(relax.start + 0.01).name == "relax"
+    assert continuous_push(0.2).lateral_constraint_end is None
 
 
 @pytest.mark.parametrize("args,message", [((-0.1,), "must be positive"), ((0.2, 0.0), "push speed"),
