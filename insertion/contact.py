@@ -13,7 +13,9 @@ over capsules, so a node near a joint between two segments is counted once):
 with c the closest point on the segment axis, v_n, v_t the normal and tangential relative
 velocity, m_eff the reduced mass of the wall node (infinite when fixed) and the rod point, and k
 the penalty of a free wall node, or the stiffer one of a held node (whose spring loads only the
-rod, so the wall's light nodes do not limit it).
+rod, so the wall's light nodes do not limit it). Given ``held_normals``, a held node's n is the
+fixed wall's rest normal instead: the fixed colon acts as a rigid smooth tube (docs/model.md,
+"Contact"), which pushes the scope across its axis but never back along it.
 Friction is Coulomb, regularised by a slip velocity v_reg: below mu f_n the contact "sticks"
 by creeping at |v_t| = v_reg |F_t| / (mu f_n); v_reg is raised where needed to mu f_n dt / m_eff
 so that the viscous friction stays stable in explicit time stepping. The reaction on the rod is
@@ -135,8 +137,8 @@ def max_displacement(x, x_ref):
 
 
 @numba.njit(cache=True, inline="always")  # a call per node would cost more than its work
-def _contact_one(c, xs, vs, ms, fixed_s, held_n, xr, vr, mr, seg, nodes, ptr, cand, radius, offset, k_free, k_held, zeta,
-                 mu, v_slip, dt, fs, rod_seg, rod_t, rod_k, rod_f, damp_f, fric_f):
+def _contact_one(c, xs, vs, ms, fixed_s, held_n, xr, vr, mr, seg, nodes, ptr, cand, radius, offset, k_free, k_held,
+                 zeta, mu, v_slip, dt, fs, rod_seg, rod_t, rod_k, rod_f, damp_f, fric_f):
     """Contact of candidate wall node ``nodes[c]``: (energy, damping power, friction power,
     active 0/1, normal force)."""
     reach = radius + offset
@@ -236,9 +238,9 @@ def contact_kernel(xs, vs, ms, fixed_s, held_n, xr, vr, mr, seg, nodes, ptr, can
     n_active = 0
     normal = 0.0
     for c in numba.prange(nodes.shape[0]):
-        e, pd, pf, a, fn = _contact_one(c, xs, vs, ms, fixed_s, held_n, xr, vr, mr, seg, nodes, ptr, cand, radius, offset,
-                                        k_free, k_held, zeta, mu, v_slip, dt, fs, rod_seg, rod_t, rod_k, rod_f,
-                                        damp_f, fric_f)
+        e, pd, pf, a, fn = _contact_one(c, xs, vs, ms, fixed_s, held_n, xr, vr, mr, seg, nodes, ptr, cand, radius,
+                                        offset, k_free, k_held, zeta, mu, v_slip, dt, fs, rod_seg, rod_t, rod_k,
+                                        rod_f, damp_f, fric_f)
         energy += e
         p_damp += pd
         p_fric += pf
@@ -257,9 +259,9 @@ def contact_kernel_serial(xs, vs, ms, fixed_s, held_n, xr, vr, mr, seg, nodes, p
     n_active = 0
     normal = 0.0
     for c in range(nodes.shape[0]):
-        e, pd, pf, a, fn = _contact_one(c, xs, vs, ms, fixed_s, held_n, xr, vr, mr, seg, nodes, ptr, cand, radius, offset,
-                                        k_free, k_held, zeta, mu, v_slip, dt, fs, rod_seg, rod_t, rod_k, rod_f,
-                                        damp_f, fric_f)
+        e, pd, pf, a, fn = _contact_one(c, xs, vs, ms, fixed_s, held_n, xr, vr, mr, seg, nodes, ptr, cand, radius,
+                                        offset, k_free, k_held, zeta, mu, v_slip, dt, fs, rod_seg, rod_t, rod_k,
+                                        rod_f, damp_f, fric_f)
         energy += e
         p_damp += pd
         p_fric += pf
@@ -473,7 +475,8 @@ class RodShellContact:
             self.build_candidates(r.x, s.x)
         kernel = contact_kernel if len(self._nodes) >= self.parallel_min_candidates else contact_kernel_serial
         energy, p_damp, p_fric, n_active, normal = kernel(
-            s.x, s.v, self.shell.mass, s.fixed, self._held_normal, r.x, r.v, self.rod.mass, self.rod.segments, self._nodes, self._ptr,
+            s.x, s.v, self.shell.mass, s.fixed, self._held_normal, r.x, r.v, self.rod.mass, self.rod.segments,
+            self._nodes, self._ptr,
             self._cand, self.rod.radius, self.offset, self.stiffness, self.held_stiffness, self.damping_ratio,
             self.friction, self.slip_velocity, dt, s.f_con, self._rod_seg, self._rod_t, self._rod_k, self._rod_f,
             self._damp_f, self._fric_f,

@@ -20,8 +20,9 @@ Modelling choices (stated so they can be cited):
   model's end depth while lying within one diameter of it along the centerline
   (``"tip_past_end"``: for RSJ 2 cm past the sigmoid's fixed end; ``"far_end"``: for RSF/THF the
   far end of the fixed exit, beyond which the tip would leave the model), when the available
-  length is pushed in (``"length_used"``), or when the tip jams (``"jam"``, :func:`insertion.outcomes.jammed`). A jam is an
-  outcome: the summary says where and under which forces.
+  length is pushed in (``"length_used"``), or when the tip jams (``"jam"``,
+  :func:`insertion.outcomes.jammed`). A jam is an outcome: the summary says where and under which
+  forces.
 """
 
 from __future__ import annotations
@@ -40,7 +41,7 @@ from insertion.colon_segments import colon_geometry
 from insertion.contact import RodShellContact
 from insertion.manoeuvre import PushProfile, continuous_push, straighten_relax_push
 from insertion.material import REFERENCE_MATERIAL_PATH, load_material
-from insertion.outcomes import characteristic_points, jammed, quasi_static_fraction
+from insertion.outcomes import JAM_PROGRESS, JAM_PUSH, characteristic_points, quasi_static_fraction
 from insertion.recording import InsertionRecorder
 from insertion.scopes import colonoscope
 from insertion.shell import Shell
@@ -192,7 +193,7 @@ def build_insertion(case: InsertionCase) -> Insertion:
                             f"cannot reach {tip_end * 100:.1f} cm into the colon; shorten --exit-length")
     if geometry.straighten_depth is not None and total_depth <= geometry.straighten_depth:
         raise ColonsimError(f"a {length * 100:.0f} cm scope cannot pass the mobile part ending "
-                            f"{geometry.straighten_depth * 100:.1f} cm in; reduce --sheath-reserve")
+                            f"{geometry.straighten_depth * 100:.1f} cm in; reduce sheath_reserve_mm")
     rod = scope.rod(start=entry - length * axis, direction=axis, length=length,
                     spacing=case.scope_spacing_mm * 1e-3)
     if geometry.straighten_depth is None:
@@ -284,7 +285,8 @@ ENDINGS = {
     "tip_past_end": "the tip passed the fixed end",
     "far_end": "the tip reached the model's far end",
     "length_used": "the scope's available length was pushed in",
-    "jam": "the tip jammed: under 1 mm of tip progress over 2 cm of push while the push force rose",
+    "jam": f"the tip jammed: under {JAM_PROGRESS * 1e3:g} mm of tip progress over {JAM_PUSH * 100:g} cm of push "
+           "while the push force rose",
 }
 
 
