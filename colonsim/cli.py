@@ -8,10 +8,13 @@ from __future__ import annotations
 
 import argparse
 import sys
+import warnings
 from pathlib import Path
 
 from colonsim import cli_surrogate, cli_sweep
-from colonsim.errors import ColonsimError
+from colonsim.errors import ColonsimError, ColonsimWarning
+from colonsim.options import finite_float, output_folder, positive_int
+from insertion.run_budget import DEFAULT_MAX_STEPS
 
 REPO_DATA = Path(__file__).resolve().parents[1] / "data"
 BUNDLED_MANIFEST = REPO_DATA / "tensile" / "manifest.csv"
@@ -188,8 +191,6 @@ def cmd_calibrate(args):
 def cmd_demo(args):
     from colonsim.demo import run_demo
 
-    if args.workers is not None and args.workers < 1:
-        raise ColonsimError(f"--workers {args.workers}; give at least 1")
     run_demo(args)
 
 
@@ -201,48 +202,58 @@ def _add_insert(sub):
                                    "and figure, and optional VTU files for ParaView.")
     p.add_argument("--segment", default="rsj", help="rsj (default), rsf, thf, thf-fixed, or straight (sanity case)")
     p.add_argument("--scope", nargs="+", default=["sdc"], help="utc, pdc, sdc or an outer diameter in mm; several allowed")
-    p.add_argument("--diameter", type=float, default=36.0, help="colon inner diameter, mm (default 36)")
-    p.add_argument("--angle", type=float, default=0.0, help="alpha (RSF) or beta (THF), degrees (default 0)")
-    p.add_argument("--friction", type=float, default=0.0, help="Coulomb friction scope/wall (default 0)")
-    p.add_argument("--wall-thickness", type=float, default=2.0, help="colon wall thickness, mm (default 2, an assumption)")
-    p.add_argument("--element-size", type=float, default=3.0, help="wall triangle size, mm (default 3)")
+    p.add_argument("--diameter", type=finite_float, default=36.0, help="colon inner diameter, mm (default 36)")
+    p.add_argument("--angle", type=finite_float, default=0.0, help="alpha (RSF) or beta (THF), degrees (default 0)")
+    p.add_argument("--friction", type=finite_float, default=0.0, help="Coulomb friction scope/wall (default 0)")
+    p.add_argument("--wall-thickness", type=finite_float, default=2.0, help="colon wall thickness, mm (default 2, an assumption)")
+    p.add_argument("--element-size", type=finite_float, default=3.0, help="wall triangle size, mm (default 3)")
     p.add_argument("--material", help="material JSON from colonsim calibrate (default: the source's parameters)")
-    p.add_argument("--flexure-angle", type=float, default=90.0,
+    p.add_argument("--flexure-angle", type=finite_float, default=90.0,
                    help="turn of the splenic (RSF) or hepatic (THF) flexure, degrees (default 90, an assumption)")
-    p.add_argument("--exit-length", type=float, default=100.0,
+    p.add_argument("--exit-length", type=finite_float, default=100.0,
                    help="mm of fixed colon after the last mobile piece (default 100, an assumption)")
     p.add_argument("--vtu", action="store_true", help="write deformed meshes for ParaView (needs meshio)")
-    p.add_argument("--snapshot-every", type=float, default=0.02, help="simulated seconds between VTU snapshots")
+    p.add_argument("--snapshot-every", type=finite_float, default=0.02, help="simulated seconds between VTU snapshots")
     p.add_argument("--threads", type=int, default=None,
                    help="Numba threads (default: all cores). Use 1 when running several insertions side by side: "
                         "oversubscribed threads slow the kernels down by an order of magnitude")
-    p.add_argument("--out", type=Path, default=Path("colonsim_results/insertion"), help="output folder")
+    p.add_argument("--max-steps", type=positive_int, default=DEFAULT_MAX_STEPS,
+                   help=f"refuse a run estimated to need more time steps (default {DEFAULT_MAX_STEPS:,}; "
+                        "a stiff wall or a fine mesh needs many)")
+    p.add_argument("--out", type=output_folder, default="colonsim_results/insertion", help="output folder")
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
     p.set_defaults(func=cmd_insert)
 
 
-def run_insertions(cases, out: Path, vtu=False, snapshot_every=0.02, show=True):
-    """Run each case, write its folder under ``out`` and a comparison; return the results."""
+def run_insertions(cases, out: Path, vtu=False, snapshot_every=0.02, show=True, max_steps=DEFAULT_MAX_STEPS):
+    """Run each case, write its folder under ``out`` and a comparison; return the results.
+
+    Every case is checked first, its run time estimated included (:mod:`insertion.run_budget`):
+    a case needing more than ``max_steps`` time steps is refused before any run starts."""
     from tqdm import tqdm
 
     from colonsim.files import save_figure, write_csv
     from insertion.results import comparison_table, insertion_figure, write_insertion
+    from insertion.run_budget import check_run_budget
     from insertion.scenario import run_insertion
 
-    for case in cases:
-        case.validate()  # all inputs checked before the first (long) run starts
+    budgets = [check_run_budget(case, max_steps) for case in cases]
     results = []
-    for case in cases:
-        bar = tqdm(total=1000, unit="mm", disable=None if show else True, dynamic_ncols=True, leave=False,
-                   mininterval=0.5, desc=f"{case.segment} {case.scope}")
+    for case, budget in zip(cases, budgets):
+        print(f"{case.segment.upper()} {case.scope.upper()}: {budget.describe()}", flush=True)
+        # the bar follows simulated time, which costs wall time evenly (depth does not: the
+        # push ramps up and RSF/THF pause), so its time left is meaningful
+        chunk_s = 0.01
+        bar = tqdm(total=round(budget.simulated_s * 1e3), unit="ms", disable=None if show else True,
+                   dynamic_ncols=True, leave=False, mininterval=0.5, desc=f"{case.segment} {case.scope} (simulated ms)")
 
-        def progress(depth, total, bar=bar):
-            bar.total = round(total * 1e3)
-            bar.n = min(round(depth * 1e3), bar.total)
-            bar.refresh()
+        def progress(tip_arc, tip_end, bar=bar):
+            bar.update(min(round(chunk_s * 1e3), bar.total - bar.n))
+            bar.set_postfix_str(f"tip {100 * tip_arc:.1f}/{100 * tip_end:.1f} cm", refresh=False)
 
         try:
-            r = run_insertion(case, progress=progress, snapshot_interval=snapshot_every if vtu else None)
+            r = run_insertion(case, progress=progress, snapshot_interval=snapshot_every if vtu else None,
+                              chunk_s=chunk_s)
         finally:
             bar.close()
         folder = out / f"{case.segment}_{r.summary['scope']['name'].replace(' ', '')}"
@@ -257,9 +268,9 @@ def run_insertions(cases, out: Path, vtu=False, snapshot_every=0.02, show=True):
               f"scope {100 * s['quasi_static']['fraction_below_10pct']['scope']:.0f} % of samples without its imposed "
               f"sliding); ended: {s['end']['reason']} at {s['end']['depth_cm']:.1f} cm; "
               f"{s['steps']} steps in {s['wall_time_s']:.1f} s -> {folder}/")
-    table = comparison_table(results)
+    table, figure = comparison_table(results), insertion_figure(results)  # both made before either file is replaced
     write_csv(out / "comparison.csv", table)
-    save_figure(insertion_figure(results), out / "comparison.png")
+    save_figure(figure, out / "comparison.png")
     print(f"comparison: {out}/comparison.csv, {out}/comparison.png")
     return results
 
@@ -283,13 +294,21 @@ def cmd_insert(args):
         from insertion.material import load_material
 
         load_material(args.material)
-    run_insertions(cases, args.out, vtu=args.vtu, snapshot_every=args.snapshot_every, show=not args.no_progress)
+    run_insertions(cases, args.out, vtu=args.vtu, snapshot_every=args.snapshot_every, show=not args.no_progress,
+                   max_steps=args.max_steps)
+
+
+class OneLineParser(argparse.ArgumentParser):
+    """Option errors as one line, like every other error (exit code 2), instead of the usage text."""
+
+    def error(self, message):
+        raise ColonsimError(f"{message} (see '{self.prog} --help')")
 
 
 def build_parser():
     from colonsim import __version__
 
-    parser = argparse.ArgumentParser(prog="colonsim", description="Colonoscope-colon interaction toolkit.")
+    parser = OneLineParser(prog="colonsim", description="Colonoscope-colon interaction toolkit.")
     parser.add_argument("--version", action="version", version=f"colonsim {__version__}")
     sub = parser.add_subparsers(dest="command", required=True)
     _add_calibrate(sub)
@@ -297,25 +316,42 @@ def build_parser():
     cli_sweep.add_parser(sub)
     cli_surrogate.add_parsers(sub)
     demo = sub.add_parser("demo", help="run the workflows on the bundled data (a few minutes on 2 cores)")
-    demo.add_argument("--out", type=Path, default=Path("colonsim_demo"), help="output folder (default colonsim_demo)")
-    demo.add_argument("--element-size", type=float, default=3.0,
+    demo.add_argument("--out", type=output_folder, default="colonsim_demo", help="output folder (default colonsim_demo)")
+    demo.add_argument("--element-size", type=finite_float, default=3.0,
                       help="wall mesh of the insertions and the sweep, mm (default 3; coarser is faster, not validated)")
-    demo.add_argument("--workers", type=int, default=None, help="processes for the demo's sweep (default: up to 2 cores)")
+    demo.add_argument("--workers", type=positive_int, default=None,
+                      help="processes for the demo's sweep (default: up to 2 cores)")
     demo.add_argument("--no-progress", action="store_true", help="no progress bar")
     demo.set_defaults(func=cmd_demo)
     return parser
 
 
+def _one_line(text) -> str:
+    return " ".join(str(text).split())
+
+
 def main(argv=None):
-    args = build_parser().parse_args(argv)
-    try:
-        args.func(args)
-    except ColonsimError as exc:
-        print(f"colonsim: error: {exc}", file=sys.stderr)
-        return 2
-    except KeyboardInterrupt:
-        print("colonsim: interrupted; files written so far are complete", file=sys.stderr)
-        return 130
+    show, shown = warnings.showwarning, set()
+
+    def show_warning(message, category, filename, lineno, file=None, line=None):
+        if not issubclass(category, ColonsimWarning):
+            show(message, category, filename, lineno, file, line)
+        elif _one_line(message) not in shown:  # each distinct warning once (a material is read per run)
+            shown.add(_one_line(message))
+            print(f"colonsim: warning: {_one_line(message)}", file=sys.stderr)
+
+    with warnings.catch_warnings():  # restores the filters and the display on return
+        warnings.simplefilter("always", ColonsimWarning)
+        warnings.showwarning = show_warning
+        try:
+            args = build_parser().parse_args(argv)
+            args.func(args)
+        except ColonsimError as exc:
+            print(f"colonsim: error: {_one_line(exc)}", file=sys.stderr)
+            return 2
+        except KeyboardInterrupt:
+            print("colonsim: interrupted; files written so far are complete", file=sys.stderr)
+            return 130
     return 0
 
 

@@ -9,12 +9,10 @@ from __future__ import annotations
 
 import argparse
 import json
-import sys
-import warnings
-from contextlib import contextmanager
 from pathlib import Path
 
 from colonsim.errors import ColonsimError
+from colonsim.options import finite_float, output_file
 
 # command-line option -> results-table column
 RAW_OPTIONS = {"scope_diameter": "scope_diameter_mm", "diameter": "diameter_mm", "angle": "angle_deg",
@@ -45,11 +43,11 @@ def _patient_options(p, scope_diameter=True):
     g.add_argument("--region", help="european (23 mm), african (36 mm): colon diameter in RSJ")
     g.add_argument("--presets", type=Path, help="JSON file overriding the preset tables")
     if scope_diameter:
-        g.add_argument("--scope-diameter", type=float, help="scope outer diameter, mm (instead of --scope)")
-    g.add_argument("--diameter", type=float, help="colon inner diameter, mm")
-    g.add_argument("--angle", type=float, help="alpha (RSF) or beta (THF), degrees")
-    g.add_argument("--friction", type=float, help="Coulomb friction scope/wall")
-    g.add_argument("--wall-thickness", type=float, help="colon wall thickness, mm")
+        g.add_argument("--scope-diameter", type=finite_float, help="scope outer diameter, mm (instead of --scope)")
+    g.add_argument("--diameter", type=finite_float, help="colon inner diameter, mm")
+    g.add_argument("--angle", type=finite_float, help="alpha (RSF) or beta (THF), degrees")
+    g.add_argument("--friction", type=finite_float, help="Coulomb friction scope/wall")
+    g.add_argument("--wall-thickness", type=finite_float, help="colon wall thickness, mm")
     g.add_argument("--strict", action="store_true", help="a query outside the training domain is an error, not a warning")
 
 
@@ -62,7 +60,7 @@ def add_parsers(sub):
                           description="Fit one GP per segment and output on the successful runs of RESULTS, "
                                       "cross-validate it, and write MODEL.json + MODEL.npz.")
     fit.add_argument("results", type=Path, help="results.parquet (or .csv) of a sweep")
-    fit.add_argument("-o", "--out", type=Path, required=True, help="model path: writes MODEL.json and MODEL.npz")
+    fit.add_argument("-o", "--out", type=_model_path, required=True, help="model path: writes MODEL.json and MODEL.npz")
     fit.add_argument("--targets", nargs="+", help="output columns to model (default: deformations, A, C, forces, stretch)")
     fit.add_argument("--segments", nargs="+", help="segments to fit (default: all in the table)")
     fit.add_argument("--cv", type=_cv, default="loo", help="'loo' (closed-form leave-one-out, default) or k folds")
@@ -85,7 +83,8 @@ def add_parsers(sub):
     plot.add_argument("--vs", required=True, help="scope, diameter, angle, friction or wall-thickness")
     plot.add_argument("--target", default="final_deformation_cm", help="output column (default final_deformation_cm)")
     _patient_options(plot)
-    plot.add_argument("-o", "--out", type=Path, required=True, help="figure file (.png, .pdf, .svg)")
+    plot.add_argument("-o", "--out", type=output_file(".png", ".pdf", ".svg"), required=True,
+                      help="figure file (.png, .pdf, .svg)")
     plot.set_defaults(func=cmd_plot)
 
     pr = sub.add_parser("predict", help="predict deformation, forces and stretch from a surrogate",
@@ -98,7 +97,7 @@ def add_parsers(sub):
                                              "scope_diameter_mm, diameter_mm, angle_deg, friction, "
                                              "wall_thickness_mm, and/or sex, age, region; options fill missing columns")
     pr.add_argument("--json", action="store_true", help="JSON output (records) instead of text")
-    pr.add_argument("-o", "--out", type=Path, help="write the predictions to this file (.csv or .json)")
+    pr.add_argument("-o", "--out", type=output_file(".csv", ".json"), help="write the predictions to this file (.csv or .json)")
     pr.set_defaults(func=cmd_predict)
 
     rec = sub.add_parser("recommend", help="rank the scopes for a patient by predicted deformation",
@@ -109,25 +108,18 @@ def add_parsers(sub):
     rec.add_argument("--target", default="final_deformation_cm", help="output to rank by (default final_deformation_cm)")
     rec.add_argument("--reference", help="scope the others are compared with (default sdc)")
     rec.add_argument("--json", action="store_true", help="JSON output")
-    rec.add_argument("-o", "--out", type=Path, help="write the JSON recommendation to this file")
+    rec.add_argument("-o", "--out", type=output_file(".json"), help="write the JSON recommendation to this file")
     rec.set_defaults(func=cmd_recommend)
 
 
-@contextmanager
-def _domain_warnings():
-    """Out-of-domain warnings as one ``colonsim: warning:`` line each on stderr."""
-    from surrogate.domain import OutOfDomainWarning
+def _model_path(text):
+    """A model path whose .json and .npz files can both be written."""
+    from surrogate.store import model_paths
 
-    with warnings.catch_warnings(record=True) as caught:
-        warnings.simplefilter("always", OutOfDomainWarning)
-        try:
-            yield
-        finally:
-            for w in caught:
-                if issubclass(w.category, OutOfDomainWarning):
-                    print(f"colonsim: warning: {w.message}", file=sys.stderr)
-                else:
-                    warnings.showwarning(w.message, w.category, w.filename, w.lineno)
+    file_type = output_file()
+    for path in model_paths(text):
+        file_type(str(path))
+    return Path(text)
 
 
 def cmd_fit(args):
@@ -261,8 +253,7 @@ def cmd_predict(args):
     unknown = sorted(set(targets) - set(model.targets))
     if unknown:
         raise ColonsimError(f"the surrogate has no target {', '.join(unknown)}; it models {', '.join(model.targets)}")
-    with _domain_warnings():
-        out = model.predict_frame(frame, targets=targets, strict=args.strict)
+    out = model.predict_frame(frame, targets=targets, strict=args.strict)
     out = out.drop(columns=[t for t in targets if out[t].isna().all()
                             for t in (t, t + "_std", t + "_low95", t + "_high95")])
     shown = [t for t in targets if t in out]
@@ -292,9 +283,8 @@ def cmd_recommend(args):
     model = load_surrogate(args.model)
     segment = _segment(args, model)
     query = _patient_query(model, segment, args, _presets(args))
-    with _domain_warnings():
-        rec = recommend(model, segment, query, scopes=args.scope, target=args.target, reference=args.reference,
-                        strict=args.strict)
+    rec = recommend(model, segment, query, scopes=args.scope, target=args.target, reference=args.reference,
+                    strict=args.strict)
     patient = describe_patient(segment, args.sex, args.age, args.region, _presets(args))
     rec["patient"] = patient
     if args.out:
@@ -316,7 +306,6 @@ def cmd_plot(args):
     segment = _segment(args, model)
     vs = VS_NAMES.get(args.vs.lower(), args.vs)
     query = _patient_query(model, segment, args, _presets(args))
-    with _domain_warnings():
-        fig = prediction_figure(model, segment, vs, query, target=args.target, scopes=args.scope, strict=args.strict)
+    fig = prediction_figure(model, segment, vs, query, target=args.target, scopes=args.scope, strict=args.strict)
     save_figure(fig, args.out)
     print(f"figure: {args.out}")

@@ -6,6 +6,9 @@ import os
 from pathlib import Path
 
 from colonsim.errors import ColonsimError
+from colonsim.files import check_output_folder
+from colonsim.options import output_folder, positive_int
+from insertion.run_budget import DEFAULT_MAX_STEPS
 
 
 def available_cores() -> int:
@@ -25,33 +28,38 @@ def add_parser(sub):
     p.add_argument("spec", nargs="?", type=Path, help="sweep TOML file")
     p.add_argument("--preset", help="thesis (the source's 39 insertions), validation (the validation report's "
                                     "16 extra runs) or smoke (3 fast runs)")
-    p.add_argument("--workers", type=int, default=None,
+    p.add_argument("--workers", type=positive_int, default=None,
                    help=f"local worker processes, one Numba thread each (default: the cores, {available_cores()} here)")
     p.add_argument("--scheduler", metavar="ADDR",
                    help="run on a Dask distributed cluster, e.g. tcp://HOST:8786 (workers: dask worker ADDR --nthreads 1)")
-    p.add_argument("--out", type=Path, help="output folder (default colonsim_results/sweep_NAME)")
+    p.add_argument("--out", type=output_folder, help="output folder (default colonsim_results/sweep_NAME); "
+                                                    "it holds one sweep, which a rerun resumes")
     p.add_argument("--retry-failed", action="store_true", help="run again the cases recorded as failed")
-    p.add_argument("--dry-run", action="store_true", help="list the cases and which are done, run nothing")
+    p.add_argument("--dry-run", action="store_true", help="check and list the cases and which are done, run nothing")
+    p.add_argument("--max-steps", type=positive_int, default=DEFAULT_MAX_STEPS,
+                   help=f"refuse the sweep if a run needs more time steps (default {DEFAULT_MAX_STEPS:,}; one run "
+                        "per material file is estimated: a material in the wrong unit makes every run long)")
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
     p.set_defaults(func=cmd_sweep)
     return p
 
 
 def cmd_sweep(args):
+    from insertion.run_budget import check_sweep_budget
     from insertion.sweep import SweepStore, describe_cases, run_sweep
     from insertion.sweep_spec import load_sweep
 
     if args.scheduler is not None and args.workers is not None:
         raise ColonsimError("--workers is for local runs; a Dask cluster (--scheduler) has its own workers")
     workers = available_cores() if args.workers is None else args.workers
-    if workers < 1:
-        raise ColonsimError(f"--workers {workers}; give at least 1")
     spec = load_sweep(args.spec, args.preset)
-    out = args.out or Path("colonsim_results") / f"sweep_{spec.name}"
+    out = args.out or check_output_folder(Path("colonsim_results") / f"sweep_{spec.name}")
     where = f"Dask cluster {args.scheduler}" if args.scheduler else f"{workers} local process{'es' if workers > 1 else ''}"
     if args.dry_run:
+        check_sweep_budget(spec.cases, args.max_steps)
         store = SweepStore(out)
         store.load()
+        store.check_same_sweep([c.key() for c in spec.cases], spec.source)
         done = store.finished(args.retry_failed)
         print(describe_cases(spec.cases))
         todo = sum(c.key() not in done for c in spec.cases)
@@ -60,7 +68,7 @@ def cmd_sweep(args):
         return
     print(f"sweep {spec.name}: {len(spec.cases)} runs on {where} -> {out}/", flush=True)
     report = run_sweep(spec.cases, out, workers=workers, scheduler=args.scheduler, retry_failed=args.retry_failed,
-                       spec=spec, progress=not args.no_progress)
+                       spec=spec, progress=not args.no_progress, max_steps=args.max_steps)
     rate = "" if report.ran == 0 else f" ({report.runs_per_hour:.0f} runs/hour)"
     print(f"{report.skipped} already finished (skipped), {report.ran} run in {report.wall_time_s:.1f} s{rate}: "
           f"{report.ok} ok, {report.failed} failed")

@@ -7,3 +7,8 @@ names the problem and the fix. The command line turns it into one line and exit 
 
 class ColonsimError(ValueError):
     """Bad user input or an unrecoverable simulation state, with an actionable message."""
+
+
+class ColonsimWarning(UserWarning):
+    """Input that is accepted but probably not meant (a wall softer than any tissue, a query outside
+    the training domain): the command line prints it as one ``colonsim: warning:`` line."""

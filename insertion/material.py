@@ -7,13 +7,22 @@ ships with the repository (:data:`REFERENCE_MATERIAL_PATH`).
 
 import json
 import math
+import warnings
 from dataclasses import dataclass
 from pathlib import Path
 
-from colonsim.errors import ColonsimError
+from colonsim.errors import ColonsimError, ColonsimWarning
 
 LAW = "mooney_rivlin_3"
 PARAMETER_NAMES = ("C10", "C01", "C11")
+# Small-strain shear modulus below which a wall is softer than any soft tissue: the softest
+# (brain, fat) are near 1 kPa, the reference colon wall 87 kPa. Below this, parameters were most
+# likely given in the wrong unit.
+SOFTEST_TISSUE_MU0_PA = 100.0
+
+
+class SoftWallWarning(ColonsimWarning):
+    """A wall material softer than any soft tissue (probably parameters in the wrong unit)."""
 
 
 def _reference_material_path():
@@ -153,6 +162,11 @@ def load_material(path):
             "give C10, C01 and C11 in Pa."
         )
     try:
-        return MooneyRivlin(*(params[name] for name in PARAMETER_NAMES))
+        material = MooneyRivlin(*(params[name] for name in PARAMETER_NAMES))
     except ColonsimError as exc:
         raise ColonsimError(f"material file {path}: {exc}") from None
+    if material.mu0 < SOFTEST_TISSUE_MU0_PA:
+        warnings.warn(f"material file {path}: small-strain shear modulus 2 (C10 + C01) = {material.mu0:.3g} Pa is "
+                      f"softer than any soft tissue (the softest, brain and fat, are near 1 kPa); are the parameters "
+                      "in Pa?", SoftWallWarning)
+    return material

@@ -4,13 +4,14 @@ Output folder::
 
     results.parquet     one row per run (columns: :data:`IDENTITY`, every InsertionCase field,
                         ``scope_diameter_mm``, :data:`OUTPUTS`); rewritten atomically after each run
-    sweep.json          the sweep that was last run here (name, seed, keys, TOML text)
+    sweep.json          the sweep this folder holds (name, seed, keys, TOML text)
     runs/<key>/         timeseries.csv, summary.json, insertion.png, final_shape.npz of each successful run
 
 A run is identified by :meth:`InsertionCase.key` (a hash of every input). Rerunning a sweep into
 the same folder skips the keys already in the table, so a killed sweep loses at most the runs
 that were in flight; failed runs are recorded with their error (rerun them with
-``retry_failed=True``) and never stop the others.
+``retry_failed=True``) and never stop the others. A folder holds one sweep: another sweep (other
+cases) written into it is refused, so that one table never mixes two sweeps.
 
 Runs go to a local process pool (:func:`local_outcomes`) or to an existing Dask distributed
 cluster (:func:`dask_outcomes`); both yield outcomes as runs finish, and only this process
@@ -34,13 +35,15 @@ from pathlib import Path
 import pandas as pd
 
 from colonsim.errors import ColonsimError
-from colonsim.files import atomic_path, write_json
+from colonsim.files import atomic_path, check_output_folder, write_json
 from colonsim.provenance import code_version
+from insertion.run_budget import DEFAULT_MAX_STEPS, check_sweep_budget
 from insertion.scenario import InsertionCase, InsertionResult
 from insertion.scopes import colonoscope
 from insertion.sweep_worker import execute, start_worker
 
 TABLE = "results.parquet"
+SWEEP_DOCUMENT = "sweep.json"
 LOCK = ".sweep.lock"
 DIED = "worker process died during this run (killed or out of memory)"
 IDENTITY = ("key", "status", "error", "wall_time_s", "timeseries_path", "finished_at", "git_commit")
@@ -147,6 +150,35 @@ class SweepStore:
         if self._lock is not None:
             self._lock.unlink(missing_ok=True)
             self._lock = None
+
+    def check_same_sweep(self, keys, source=None):
+        """Refuse to resume here a sweep other than the one this folder holds.
+
+        The same sweep: the same cases (keys), or the same TOML text (its keys change when the
+        case fields change with the code). A folder without ``sweep.json`` holds the rows of its
+        table: every one must be a case of this sweep."""
+        keys = set(keys)
+        path = self.folder / SWEEP_DOCUMENT
+        if path.is_file():
+            import json
+
+            try:
+                held = json.loads(path.read_text(encoding="utf-8"))
+                held_keys, held_source = set(held["keys"]), held.get("toml")
+            except (ValueError, KeyError, TypeError) as exc:
+                raise ColonsimError(f"cannot read {path} ({type(exc).__name__}); it should name the sweep this folder "
+                                    "holds: use another --out") from None
+            if held_keys == keys or (source and held_source == source):
+                return
+            name = held.get("name")
+        else:
+            held_keys, name = set(self.rows), None
+            if held_keys <= keys:
+                return
+        common = len(held_keys & keys)
+        raise ColonsimError(f"{self.folder} holds another sweep{f' ({name!r})' if name else ''} of {len(held_keys)} "
+                            f"runs ({len(self.rows)} recorded, {common} in common with this one of {len(keys)}); "
+                            "resume that one with its own file, or give this sweep another --out")
 
     def finished(self, retry_failed=False) -> set:
         """Keys that need no new run: ok runs, and failed ones unless ``retry_failed``."""
@@ -318,7 +350,7 @@ class SweepReport:
 
 
 def run_sweep(cases, out, workers=2, scheduler=None, runner=None, retry_failed=False, spec=None,
-              progress=True, log=print) -> SweepReport:
+              progress=True, log=print, max_steps=DEFAULT_MAX_STEPS) -> SweepReport:
     """Run every case of a sweep not yet finished in ``out``; record each run as it finishes.
 
     Parameters
@@ -337,15 +369,20 @@ def run_sweep(cases, out, workers=2, scheduler=None, runner=None, retry_failed=F
     retry_failed : bool
         Run again the cases recorded as failed.
     spec : SweepSpec or None
-        Written to ``sweep.json`` for the record.
+        Written to ``sweep.json``: it names the sweep the folder holds.
+    max_steps : int
+        Refuse the sweep if a run of one of its materials needs more time steps
+        (:func:`insertion.run_budget.check_sweep_budget`).
     """
     if workers < 1:
         raise ColonsimError(f"workers = {workers}; give at least 1 worker process")
     for case in cases:
         case.validate()
-    out = Path(out)
+    out = check_output_folder(out)
+    check_sweep_budget(cases, max_steps)
     t0 = time.perf_counter()
     with SweepStore(out) as store:
+        store.check_same_sweep([c.key() for c in cases], spec.source if spec is not None else None)
         done = store.finished(retry_failed)
         todo = [c for c in cases if c.key() not in done]
         skipped = len(cases) - len(todo)
@@ -358,8 +395,8 @@ def run_sweep(cases, out, workers=2, scheduler=None, runner=None, retry_failed=F
         if todo:  # a Dask client connects here: an unreachable scheduler fails before sweep.json is written
             outcomes = (dask_outcomes(todo, scheduler, runner, log) if scheduler
                         else local_outcomes(todo, min(workers, len(todo)), runner))
-        if spec is not None:
-            write_json(out / "sweep.json", spec.document())
+        write_json(out / SWEEP_DOCUMENT, spec.document() if spec is not None else
+                   {"name": None, "runs": len(cases), "keys": [c.key() for c in cases]})
         if outcomes is not None:
             from tqdm import tqdm
 

@@ -44,6 +44,9 @@ or, for a space-filling design crossed with a grid (2 x 20 runs)::
 - Cases that come out identical (same :meth:`InsertionCase.key`) run once.
 
 Every case is validated before anything runs; errors are one line naming the key and the fix.
+Numbers must be finite (TOML allows ``inf`` and ``nan``), a sweep must vary something (``[fixed]``
+alone is one run: use ``colonsim insert``), and a sweep holds at most :data:`MAX_RUNS` runs,
+counted before any case is generated.
 """
 
 from __future__ import annotations
@@ -51,6 +54,7 @@ from __future__ import annotations
 import dataclasses
 import difflib
 import itertools
+import math
 import sys
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -69,6 +73,10 @@ SCOPE_DIAMETER = "scope_diameter_mm"
 SECTIONS = ("sweep", "fixed", "grid", "lhs")
 SWEEP_KEYS = ("name", "seed", "description")
 LHS_DECIMALS = 3
+MAX_RUNS = 20_000  # ~3 s to expand and validate; 28 hours of computing at the fastest runs measured
+# Wall time of one run on one core: the thesis preset on the 2-core development machine (README):
+# RSJ 5-17 s, RSF 45-120 s, THF 50-260 s at the default mesh.
+RUN_SECONDS = (5.0, 260.0)
 
 PRESETS = {
     # The source's Chapter V: RSJ D23/D36 x 3 scopes x mu 0/0.05/0.1 (18 runs); RSF alpha and THF
@@ -200,16 +208,19 @@ def _coerce(name, value, where, base: Path | None):
     if name == "scope":
         if isinstance(value, bool) or not isinstance(value, (str, int, float)):
             raise ColonsimError(f"{where}: scope = {value!r}; give utc, pdc, sdc or a diameter in mm")
-        return "scope", (f"{value:g}" if isinstance(value, (int, float)) else value.strip().lower())
+        return "scope", (f"{_number(name, value, where):g}" if isinstance(value, (int, float)) else value.strip().lower())
     if name == "material":
         if not isinstance(value, str):
             raise ColonsimError(f"{where}: material = {value!r}; give the path of a material JSON or \"\" for the default")
         if not value:
             return name, None
-        path = Path(value).expanduser()
-        if base is not None and not path.is_absolute():
-            path = base / path
-        return name, str(path.resolve())
+        try:
+            path = Path(value).expanduser()
+            if base is not None and not path.is_absolute():
+                path = base / path
+            return name, str(path.resolve())
+        except (OSError, ValueError, RuntimeError) as exc:  # a NUL byte, an unknown ~user, a symlink loop
+            raise ColonsimError(f"{where}: material = {value!r} is not a usable path ({exc})") from None
     if isinstance(default, bool):
         if not isinstance(value, bool):
             raise ColonsimError(f"{where}: {name} = {value!r}; give true or false")
@@ -230,7 +241,14 @@ def _coerce(name, value, where, base: Path | None):
 def _number(name, value, where):
     if isinstance(value, bool) or not isinstance(value, (int, float)):
         raise ColonsimError(f"{where}: {name} = {value!r}; give a number")
-    return float(value)
+    try:
+        number = float(value)
+    except OverflowError:  # a TOML integer beyond any float
+        number = math.inf
+    if not math.isfinite(number):
+        shown = repr(value) if len(repr(value)) <= 40 else f"{repr(value)[:12]}... ({len(repr(value))} digits)"
+        raise ColonsimError(f"{where}: {name} = {shown}; give a finite number")
+    return number
 
 
 def _axis_keys(table, where):
@@ -240,6 +258,13 @@ def _axis_keys(table, where):
             _unknown(key, where, known)
     if "scope" in table and SCOPE_DIAMETER in table:
         raise ColonsimError(f"[{where}] gives both scope and {SCOPE_DIAMETER}; they are the same axis, keep one")
+
+
+def _grid_size(block, where) -> int:
+    """Cases of a grid block (the product of its list lengths), counted without making them."""
+    if not block:
+        raise ColonsimError(f"[{where}] is empty; give at least one key = [values], or remove the block")
+    return math.prod(len(v) if isinstance(v, list) else 1 for v in block.values())
 
 
 def _grid_cases(block, where, base):
@@ -271,11 +296,14 @@ def _lhs_cases(table, seed, base):
     ranges = []
     for key, bounds in table.items():
         if (not isinstance(bounds, list) or len(bounds) != 2
-                or any(isinstance(b, bool) or not isinstance(b, (int, float)) for b in bounds) or not bounds[0] < bounds[1]):
+                or any(isinstance(b, bool) or not isinstance(b, (int, float)) for b in bounds)):
+            raise ColonsimError(f"[lhs] {key} = {bounds!r}; give a range [low, high] of numbers with low < high")
+        low, high = (_number(key, b, "[lhs]") for b in bounds)
+        if not (low < high and math.isfinite(high - low)):
             raise ColonsimError(f"[lhs] {key} = {bounds!r}; give a range [low, high] of numbers with low < high")
         if key != SCOPE_DIAMETER and not isinstance(case_fields()[key].default, float):
             raise ColonsimError(f"[lhs] {key} is not a continuous input; put it in a [[grid]] block instead")
-        ranges.append((key, float(bounds[0]), float(bounds[1])))
+        ranges.append((key, low, high))
     unit = latin_hypercube(samples, len(ranges), seed)
     cases = []
     for row in unit:
@@ -329,13 +357,19 @@ def parse_sweep(text: str, base: Path | None = None, origin: str = "sweep") -> S
     blocks = [grid] if isinstance(grid, dict) else grid
     if not isinstance(blocks, list) or not all(isinstance(b, dict) for b in blocks):
         raise ColonsimError(f"{origin}: [grid] / [[grid]] must be tables of key = [values]")
+    wheres = ["grid" if len(blocks) == 1 else f"grid block {i}" for i in range(1, len(blocks) + 1)]
+    lhs = doc.get("lhs")
+    if lhs is not None and not isinstance(lhs, dict):
+        raise ColonsimError(f"{origin}: [lhs] must be a table (samples = N and ranges key = [low, high])")
+    if not blocks and lhs is None:
+        what = "only [fixed] values: that is one run (use `colonsim insert` for it)" if fixed else "no runs"
+        raise ColonsimError(f"{origin} describes {what}; add a [[grid]] block or an [lhs] table with the inputs to vary")
+    _check_size(origin, [_grid_size(b, w) for b, w in zip(blocks, wheres)], lhs)
     grid_cases = []
     grid_keys = set()
-    for i, block in enumerate(blocks, 1):
-        where = "grid" if len(blocks) == 1 else f"grid block {i}"
+    for block, where in zip(blocks, wheres):
         grid_cases += _grid_cases(block, where, base)
         grid_keys |= {("scope" if k == SCOPE_DIAMETER else k) for k in block}
-    lhs = doc.get("lhs")
     lhs_cases = _lhs_cases(lhs, seed, base) if lhs is not None else []
     lhs_keys = {("scope" if k == SCOPE_DIAMETER else k) for k in (lhs or {}) if k != "samples"}
     fixed_keys = set(fixed)
@@ -348,8 +382,6 @@ def parse_sweep(text: str, base: Path | None = None, origin: str = "sweep") -> S
         combos = grid_cases or [{}]
     else:
         combos = [{**g, **s} for g in (grid_cases or [{}]) for s in lhs_cases]
-    if not grid_cases and lhs is None and not fixed:
-        raise ColonsimError(f"{origin} describes no runs; add a [[grid]] block, an [lhs] table or a preset")
     cases, seen = [], set()
     for values in combos:
         case = InsertionCase(**{**fixed, **values})
@@ -364,6 +396,25 @@ def parse_sweep(text: str, base: Path | None = None, origin: str = "sweep") -> S
     _check_materials(cases)
     return SweepSpec(name=name.strip(), seed=seed, description=str(head.get("description", "")), cases=cases,
                      source=text)
+
+
+def _check_size(origin, grid_sizes, lhs):
+    """Refuse a sweep of more than :data:`MAX_RUNS` runs before making any case (a hypercube of
+    1e8 samples would take minutes to draw and years to run)."""
+    samples = lhs.get("samples") if isinstance(lhs, dict) else None
+    samples = samples if isinstance(samples, int) and not isinstance(samples, bool) and samples > 0 else 1
+    grid = sum(grid_sizes)
+    runs = max(grid, 1) * samples
+    if runs <= MAX_RUNS:
+        return
+    from insertion.run_budget import human_duration
+
+    parts = [f"{grid:,} grid cases"] if grid else []
+    parts += [f"{samples:,} hypercube samples"] if lhs is not None else []
+    low, high = (human_duration(runs * s if runs < 1e300 else math.inf) for s in RUN_SECONDS)
+    raise ColonsimError(f"{origin} asks for {runs:,} runs ({' x '.join(parts)}), more than the {MAX_RUNS:,} a sweep may "
+                        f"hold: at {RUN_SECONDS[0]:g}-{RUN_SECONDS[1]:g} s per run on one core that is {low} to {high} "
+                        "of computing; lower the samples or the grid, or split it into sweeps with separate --out")
 
 
 def _check_materials(cases):

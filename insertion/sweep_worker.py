@@ -14,6 +14,7 @@ import os
 import sys
 import threading
 import time
+import warnings
 
 _PREPARED = False
 # Runs of one process go one at a time: the Numba threading layers are not all safe for
@@ -45,6 +46,11 @@ def prepare_worker():
     """
     global _PREPARED
     _one_thread()
+    from colonsim.errors import ColonsimWarning
+
+    # the sweep's own process has shown these once, when it checked the cases; a worker would
+    # repeat them for every run, in the raw warnings format
+    warnings.simplefilter("ignore", ColonsimWarning)
     with _RUN_LOCK:
         if _PREPARED:
             return
@@ -54,8 +60,30 @@ def prepare_worker():
         _PREPARED = True
 
 
+def exit_with_parent():
+    """Exit this process as soon as the process that started it dies.
+
+    A pool worker waits on a queue that it holds both ends of, so the death of a sweep killed
+    with SIGKILL (the out-of-memory killer) never reaches it: without this it idles forever. The
+    parent's sentinel (a pipe the parent holds open) becomes readable when the parent dies, even
+    while this process runs a case."""
+    import multiprocessing
+    from multiprocessing.connection import wait
+
+    parent = multiprocessing.parent_process()
+    if parent is None:
+        return
+
+    def watch():
+        wait([parent.sentinel])
+        os._exit(1)  # no cleanup to wait for: the parent, which writes every file, is gone
+
+    threading.Thread(target=watch, name="exit-with-parent", daemon=True).start()
+
+
 def start_worker():
     """Initializer of a local pool process (must not raise: the pool would break)."""
+    exit_with_parent()
     try:
         prepare_worker()
     except (Exception, KeyboardInterrupt):  # the first run calls it again and records the error; Ctrl-C: quietly

@@ -13,15 +13,27 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from colonsim.errors import ColonsimError
-from surrogate.table import INPUT_OPTIONS
+from colonsim.errors import ColonsimError, ColonsimWarning
+from surrogate.table import INPUT_OPTIONS, INPUTS
 
 # Relative slack of the bounds (a fraction of the range, or of the value for a fixed input), so
 # that round-off in a query ("9.2" vs 9.200000001) is not "outside".
 TOLERANCE = 1e-6
+# Farther than this many training ranges outside the domain a query is no extrapolation but a slip
+# (a unit, a typo): the GP's length scales are at most 100 ranges, so there it returns its prior
+# whatever the value, and squared distances of ~1e154 ranges overflow to NaN.
+FAR = 1e4
 
 
-class OutOfDomainWarning(UserWarning):
+def _is_number(value) -> bool:
+    try:
+        float(np.nan if value is None else value)
+    except (TypeError, ValueError):
+        return False
+    return True
+
+
+class OutOfDomainWarning(ColonsimWarning):
     """A query lies outside the inputs the surrogate was trained on: its prediction is an extrapolation."""
 
 
@@ -66,7 +78,7 @@ class SegmentDomain:
             ranges = ", ".join(f"{m} ({self.low[self.inputs.index(m)]:g}-{self.high[self.inputs.index(m)]:g} in the runs; "
                                f"{INPUT_OPTIONS.get(m, m)} on the command line)" for m in missing)
             raise ColonsimError(f"segment {self.segment}: give {ranges}; the surrogate depends on it")
-        cols = [np.atleast_1d(np.asarray(query[name], dtype=float)) for name in self.inputs]
+        cols = [self.numbers(query[name], name) for name in self.inputs]
         if n is None:
             n = max([len(c) for c in cols], default=1)
         X = np.column_stack([np.broadcast_to(c, (n,)) for c in cols]) if cols else np.zeros((n, 0))
@@ -75,17 +87,51 @@ class SegmentDomain:
             raise ColonsimError(f"segment {self.segment}: query {i + 1} lacks {self.inputs[j]}; the surrogate depends on it")
         return X
 
+    def numbers(self, values, name) -> np.ndarray:
+        """``values`` of input ``name`` as a float array (NaN = not given); a text that is no number
+        or an infinite value is an error naming the query and the input."""
+        raw = np.atleast_1d(np.asarray(values, dtype=object))
+        try:
+            out = raw.astype(float)
+        except (TypeError, ValueError):
+            i = next(i for i, v in enumerate(raw) if not _is_number(v))
+            raise ColonsimError(f"segment {self.segment}: query {i + 1} has {name} = {raw[i]!r}; give a number") from None
+        infinite = np.flatnonzero(np.isinf(out))
+        if infinite.size:
+            i = infinite[0]
+            raise ColonsimError(f"segment {self.segment}: query {i + 1} has {name} = {raw[i]!r}; give a finite number")
+        return out
+
+    def unknown_inputs(self, query: dict) -> list:
+        """Candidate inputs the query sets but the model has neither as an input nor as a fixed
+        value (the results table had no such column): the model cannot answer for them."""
+        return [name for name in INPUTS if name not in self.inputs and name not in self.fixed
+                and query.get(name) is not None and not np.isnan(self.numbers(query[name], name)).all()]
+
     def check(self, query: dict, n=None, strict=False, warn=True):
         """The model's input matrix of ``query`` and the rows outside the domain.
 
         Returns (X, inside, reasons): the (n, d) inputs, a boolean array and, per row, a text naming
         the offending inputs ("" inside). Raises :class:`ColonsimError` with ``strict``; otherwise warns once
         (:class:`OutOfDomainWarning`) when ``warn``."""
+        unknown = self.unknown_inputs(query)
+        if unknown:
+            options = ", ".join(INPUT_OPTIONS.get(u, u) for u in unknown)
+            raise ColonsimError(f"segment {self.segment}: the surrogate was fitted on a table without "
+                                f"{', '.join(unknown)}, so it cannot take it into account; leave {options} out of the "
+                                "query or refit on a results table with that column")
         X = self.matrix(query, n)
         reasons = [[] for _ in range(len(X))]
         span = np.maximum(self.high - self.low, 0.0)
         below = X < self.low - TOLERANCE * span
         above = X > self.high + TOLERANCE * span
+        with np.errstate(over="ignore"):  # inf distance is as far as it gets
+            distance = np.maximum(self.low - X, X - self.high) / np.where(span > 0, span, 1.0)
+        if (distance > FAR).any():
+            i, j = np.argwhere(distance > FAR)[0]
+            raise ColonsimError(f"segment {self.segment}: query {i + 1} has {self.inputs[j]} = {X[i, j]:g}, more than "
+                                f"{FAR:,.0f} times the training range ({self.low[j]:g}-{self.high[j]:g}) outside it; "
+                                "check the value and its unit")
         for j, name in enumerate(self.inputs):
             for i in np.flatnonzero(below[:, j] | above[:, j]):
                 reasons[i].append(f"{name} {X[i, j]:g} outside {self.low[j]:g}-{self.high[j]:g}")
@@ -93,7 +139,7 @@ class SegmentDomain:
             given = query.get(name)
             if given is None:
                 continue
-            arr = np.broadcast_to(np.atleast_1d(np.asarray(given, dtype=float)), (len(X),))
+            arr = np.broadcast_to(self.numbers(given, name), (len(X),))
             off = np.abs(arr - value) > TOLERANCE * max(1.0, abs(value))  # NaN = not given: not off
             for i in np.flatnonzero(off):
                 reasons[i].append(f"{name} {arr[i]:g} but every {self.segment} run used {value:g}")

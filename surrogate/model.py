@@ -15,8 +15,8 @@ import pandas as pd
 from colonsim.errors import ColonsimError
 from surrogate.domain import SegmentDomain
 from surrogate.gp import GaussianProcess
-from surrogate.table import (INPUTS, TARGETS, check_results, scope_diameter_mm, scope_diameters, solver_settings,
-                             split_inputs, successful_runs)
+from surrogate.table import (INPUT_OPTIONS, INPUTS, TARGETS, check_results, numeric_column, scope_diameter_mm,
+                             scope_diameters, solver_settings, split_inputs, successful_runs)
 from surrogate.validation import Z95, cross_validate
 
 
@@ -77,6 +77,11 @@ class SweepSurrogate:
         self.domains_, self.models_, self.cv_, self.skipped_, self.notes_ = {}, {}, {}, {}, []
         self.training_ = {"runs": int(len(table)), "ok": int((table["status"] == "ok").sum()),
                           "failed": int((table["status"] != "ok").sum())}
+        absent = [name for name in self.inputs if name not in table.columns]
+        if absent:
+            self.notes_.append(f"the table has no column {', '.join(absent)}: the model cannot take "
+                               f"{'it' if len(absent) == 1 else 'them'} into account, and a query that sets "
+                               f"{', '.join(INPUT_OPTIONS.get(a, a) for a in absent)} is refused")
         for segment in segments:
             runs = successful_runs(table, segment)
             if runs.empty:
@@ -100,7 +105,7 @@ class SweepSurrogate:
                                    "they train like the others")
             self.models_[segment], self.cv_[segment], self.skipped_[segment] = {}, {}, {}
             for target in self.targets:
-                y = runs[target].to_numpy(dtype=float)
+                y = numeric_column(runs, target).to_numpy()
                 keep = np.isfinite(y)
                 if not varying:
                     self.skipped_[segment][target] = "no input varies over the runs"
@@ -108,8 +113,17 @@ class SweepSurrogate:
                     self.skipped_[segment][target] = f"{int(keep.sum())} runs with a value (< {self.min_runs})"
                 if target in self.skipped_[segment]:
                     continue
+                why = [f"{int(n)} {what}" for n, what in ((np.isinf(y).sum(), "with an infinite value"),
+                                                          (np.isnan(y).sum(), "without a value (NaN)")) if n]
+                if why:
+                    self.notes_.append(f"{segment} {target}: {int((~keep).sum())} of {len(y)} successful runs left "
+                                       f"out ({' and '.join(why)}), {int(keep.sum())} used")
                 X = runs.loc[keep, varying].to_numpy(dtype=float)
-                gp = self._make_gp(domain)().fit(X, y[keep])
+                with np.errstate(over="ignore", invalid="ignore"):  # an overflow shows in the check below
+                    gp = self._make_gp(domain)().fit(X, y[keep])
+                if not all(np.isfinite(v).all() for v in (gp.y_scale_, gp.alpha_, gp.L_, gp.length_scale_)):
+                    raise ColonsimError(f"{segment} {target}: the fit is not finite (values from {y[keep].min():.3g} "
+                                        f"to {y[keep].max():.3g}); check that column's values and unit")
                 self.models_[segment][target] = gp
                 self.cv_[segment][target] = cross_validate(gp, X, y[keep], self.cv, self._make_gp(domain),
                                                            self.random_state)

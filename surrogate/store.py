@@ -20,7 +20,7 @@ import numpy as np
 from colonsim import __version__
 from colonsim.provenance import code_version
 from colonsim.errors import ColonsimError
-from colonsim.files import atomic_path, write_json
+from colonsim.files import atomic_paths, json_text
 from surrogate.domain import SegmentDomain
 from surrogate.gp import GaussianProcess
 from surrogate.model import SweepSurrogate
@@ -64,20 +64,27 @@ def save_surrogate(model: SweepSurrogate, path, source=None):
                 "cross_validation": model.cv_[seg][target],
             }
         segments[seg] = {"domain": domain.to_dict(), "models": entries, "skipped": model.skipped_[seg]}
-    with atomic_path(npz_path) as tmp:
-        np.savez(tmp, **arrays)
-        digest = _sha256(tmp)
     doc = {"format": FORMAT, "format_version": FORMAT_VERSION, "colonsim_version": __version__,
            "git_commit": code_version()["git_commit"],
            "created": datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds"),
            "source": None if source is None else str(source),
-           "arrays": {"file": npz_path.name, "sha256": digest},
+           "arrays": {"file": npz_path.name, "sha256": None},
            "estimator": {"targets": list(model.targets), "inputs": list(model.inputs),
                          "segments": None if model.segments is None else list(model.segments), "cv": model.cv,
                          "n_restarts": model.n_restarts, "min_runs": model.min_runs, "random_state": model.random_state,
                          "threads": model.threads},
            "training": model.training_, "notes": model.notes_, "segments": segments}
-    write_json(json_path, doc)
+    bad = next((k for k, a in arrays.items() if not np.isfinite(a).all()), None)
+    if bad is not None:
+        raise ColonsimError(f"cannot save the surrogate: array {bad} is not finite; nothing was written")
+    # Both files are complete and checked before either replaces an earlier model: a failure
+    # leaves the earlier pair as it was (and no stray file), never a .npz of one fit beside the
+    # .json of another.
+    with atomic_paths(npz_path, json_path) as (npz_tmp, json_tmp):
+        np.savez(npz_tmp, **arrays)
+        doc["arrays"]["sha256"] = _sha256(npz_tmp)
+        json_tmp.write_text(json_text(doc, json_path.name), encoding="utf-8")
+        _read_pair(json.loads(json_tmp.read_text(encoding="utf-8")), json_tmp, npz_tmp)  # reads back as a model
     return json_path, npz_path
 
 
@@ -95,31 +102,43 @@ def load_surrogate(path) -> SweepSurrogate:
     if str(doc.get("format_version", "")).split(".")[0] != FORMAT_VERSION.split(".")[0]:
         raise ColonsimError(f"{json_path} has surrogate format {doc.get('format_version')}, this colonsim reads "
                             f"{FORMAT_VERSION}; refit it with this version")
-    npz_path = json_path.with_name(doc["arrays"]["file"])
+    try:
+        npz_path = json_path.with_name(doc["arrays"]["file"])
+    except (KeyError, TypeError):
+        raise ColonsimError(f"{json_path} names no arrays file; refit the surrogate") from None
+    return _read_pair(doc, json_path, npz_path)
+
+
+def _read_pair(doc, json_path, npz_path) -> SweepSurrogate:
+    """The model of a JSON document ``doc`` (read from ``json_path``) and its arrays file."""
     if not npz_path.is_file():
         raise ColonsimError(f"arrays file {npz_path} of {json_path} is missing; keep the .json and .npz together")
-    if _sha256(npz_path) != doc["arrays"]["sha256"]:
+    if _sha256(npz_path) != doc["arrays"].get("sha256"):
         raise ColonsimError(f"{npz_path} does not belong to {json_path} (checksum differs); copy both files of one fit")
-    est = doc["estimator"]
-    model = SweepSurrogate(targets=tuple(est["targets"]), inputs=tuple(est["inputs"]), segments=est["segments"],
-                           cv=est["cv"], n_restarts=est["n_restarts"], min_runs=est["min_runs"],
-                           random_state=est["random_state"], threads=est.get("threads", 1))
-    model.training_, model.notes_ = doc["training"], list(doc["notes"])
-    model.domains_, model.models_, model.cv_, model.skipped_ = {}, {}, {}, {}
-    with np.load(npz_path, allow_pickle=False) as arrays:
-        for seg, entry in doc["segments"].items():
-            domain = SegmentDomain.from_dict(entry["domain"])
-            model.domains_[seg] = domain
-            model.models_[seg], model.cv_[seg], model.skipped_[seg] = {}, {}, dict(entry["skipped"])
-            for target, m in entry["models"].items():
-                gp = GaussianProcess(input_range=(domain.low, domain.high))
-                gp.x_low_, gp.x_span_ = np.asarray(m["x_low"], dtype=float), np.asarray(m["x_span"], dtype=float)
-                gp.y_mean_, gp.y_scale_ = float(m["y_mean"]), float(m["y_scale"])
-                gp.constant_, gp.noise_level_ = float(m["constant"]), float(m["noise_level"])
-                gp.length_scale_ = np.array([m["length_scale"][n] for n in domain.inputs], dtype=float)
-                gp.log_marginal_likelihood_ = float(m["log_marginal_likelihood"])
-                for name in ARRAYS:
-                    setattr(gp, name + "_", arrays[_key(seg, target, name)])
-                model.models_[seg][target] = gp
-                model.cv_[seg][target] = m["cross_validation"]
+    try:
+        est = doc["estimator"]
+        model = SweepSurrogate(targets=tuple(est["targets"]), inputs=tuple(est["inputs"]), segments=est["segments"],
+                               cv=est["cv"], n_restarts=est["n_restarts"], min_runs=est["min_runs"],
+                               random_state=est["random_state"], threads=est.get("threads", 1))
+        model.training_, model.notes_ = doc["training"], list(doc["notes"])
+        model.domains_, model.models_, model.cv_, model.skipped_ = {}, {}, {}, {}
+        with np.load(npz_path, allow_pickle=False) as arrays:
+            for seg, entry in doc["segments"].items():
+                domain = SegmentDomain.from_dict(entry["domain"])
+                model.domains_[seg] = domain
+                model.models_[seg], model.cv_[seg], model.skipped_[seg] = {}, {}, dict(entry["skipped"])
+                for target, m in entry["models"].items():
+                    gp = GaussianProcess(input_range=(domain.low, domain.high))
+                    gp.x_low_, gp.x_span_ = np.asarray(m["x_low"], dtype=float), np.asarray(m["x_span"], dtype=float)
+                    gp.y_mean_, gp.y_scale_ = float(m["y_mean"]), float(m["y_scale"])
+                    gp.constant_, gp.noise_level_ = float(m["constant"]), float(m["noise_level"])
+                    gp.length_scale_ = np.array([m["length_scale"][n] for n in domain.inputs], dtype=float)
+                    gp.log_marginal_likelihood_ = float(m["log_marginal_likelihood"])
+                    for name in ARRAYS:
+                        setattr(gp, name + "_", arrays[_key(seg, target, name)])
+                    model.models_[seg][target] = gp
+                    model.cv_[seg][target] = m["cross_validation"]
+    except (KeyError, TypeError, ValueError, AttributeError, OSError) as exc:
+        raise ColonsimError(f"{json_path} or its arrays file is damaged ({type(exc).__name__}: {exc}); "
+                            "refit the surrogate") from None
     return model

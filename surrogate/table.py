@@ -50,18 +50,50 @@ def read_results(path) -> pd.DataFrame:
 
 
 def check_results(frame: pd.DataFrame, name="results table") -> pd.DataFrame:
-    """The table with its required columns checked and the segment names normalized."""
+    """The table with its required columns checked, the segment names normalized and the inputs
+    and outputs the surrogate reads made numeric."""
     missing = [c for c in REQUIRED if c not in frame.columns]
     if missing:
         raise ColonsimError(f"{name} lacks the column(s) {', '.join(missing)}; is it a sweep's results table?")
-    frame = frame.copy()
+    frame = frame.reset_index(drop=True)
+    blank = frame["segment"].isna() | (frame["segment"].astype(str).str.strip() == "")
+    if blank.any():
+        raise ColonsimError(f"{name}: {int(blank.sum())} row(s) have no segment ({_rows(frame, blank)}); fill it in "
+                            f"({', '.join(SEGMENTS)}) or remove those rows")
     frame["segment"] = frame["segment"].astype(str).str.strip().str.lower()
     unknown = sorted(set(frame["segment"]) - set(SEGMENTS))
     if unknown:
         raise ColonsimError(f"{name} has unknown segment(s) {', '.join(unknown)}; expected {', '.join(SEGMENTS)}")
+    for column in (*INPUTS, *TARGET_LABELS):
+        if column in frame.columns:
+            frame[column] = numeric_column(frame, column, name)
+    for column in INPUTS:
+        if column in frame.columns and np.isinf(frame[column]).any():
+            raise ColonsimError(f"{name}: input {column} is infinite in {_rows(frame, np.isinf(frame[column]))}; "
+                                "fix or remove those rows")
     if not (frame["status"] == "ok").any():
         raise ColonsimError(f"{name} has no run with status 'ok'; nothing to fit")
     return frame
+
+
+def _rows(frame: pd.DataFrame, mask) -> str:
+    """The rows of ``mask`` as a user finds them: by run key if the table has one, else by data row."""
+    mask = np.asarray(mask, dtype=bool)
+    index = np.flatnonzero(mask)
+    names = ([f"run {k}" for k in frame["key"].to_numpy()[index[:3]]] if "key" in frame.columns
+             else [f"data row {i + 1}" for i in index[:3]])
+    return ", ".join(names) + (f" and {len(index) - 3} more" if len(index) > 3 else "")
+
+
+def numeric_column(frame: pd.DataFrame, column, name="results table") -> pd.Series:
+    """``frame[column]`` as floats (blank = NaN); a text that is no number is an error naming the row."""
+    values = pd.to_numeric(frame[column], errors="coerce")
+    bad = values.isna() & frame[column].notna() & (frame[column].astype(str).str.strip() != "")
+    if bad.any():
+        first = frame[column][bad].iloc[0]
+        raise ColonsimError(f"{name}: column {column} holds {first!r}, not a number, in {_rows(frame, bad)}; "
+                            "fix or remove those rows")
+    return values.astype(float)
 
 
 def successful_runs(frame: pd.DataFrame, segment: str) -> pd.DataFrame:

@@ -137,5 +137,19 @@ def test_zero_small_strain_stiffness(tmp_path):
 
 
 def test_integer_parameters_become_floats(tmp_path):
-    mat = load_material(write(tmp_path, good(parameters={"C10": 1, "C01": 2, "C11": 0})))
-    assert isinstance(mat.C10, float) and mat.E0 == 18.0
+    mat = load_material(write(tmp_path, good(parameters={"C10": 1000, "C01": 2000, "C11": 0})))
+    assert isinstance(mat.C10, float) and mat.E0 == 18000.0
+
+
+def test_a_wall_softer_than_any_tissue_is_loaded_with_a_warning(tmp_path, capsys):
+    from colonsim.cli import main
+    from insertion.material import SoftWallWarning
+
+    soft = write(tmp_path, good(parameters={"C10": 1e-6, "C01": 0.0, "C11": 0.0}))
+    with pytest.warns(SoftWallWarning, match="2e-06 Pa is softer than any soft tissue"):
+        assert load_material(soft).mu0 == pytest.approx(2e-6)
+    # on the command line: one warning line, however often the file is read (here per check)
+    (tmp_path / "s.toml").write_text(f'[fixed]\nmaterial = "{soft.name}"\n[[grid]]\nscope = ["utc", "sdc"]\n')
+    assert main(["sweep", str(tmp_path / "s.toml"), "--dry-run", "--out", str(tmp_path / "out")]) == 0
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith("colonsim: warning: material file") and "softer than any" in err[0]

@@ -134,6 +134,49 @@ def test_failed_runs_and_nan_targets_are_left_out():
     assert m.cv_["rsj"]["final_deformation_cm"]["n"] == 8 and m.cv_["rsj"]["max_deformation_cm"]["n"] == 9
 
 
+def test_rows_left_out_are_counted_with_the_reason():
+    table = synthetic_sweep(n_runs=12, segments=("rsj",), n_failed=0, seed=4)
+    table.loc[2, "final_deformation_cm"] = np.inf
+    table.loc[5, "final_deformation_cm"] = np.nan
+    m = SweepSurrogate(targets=("final_deformation_cm",), n_restarts=0).fit(table)
+    assert m.cv_["rsj"]["final_deformation_cm"]["n"] == 10
+    assert ("rsj final_deformation_cm: 2 of 12 successful runs left out (1 with an infinite value and 1 without "
+            "a value (NaN)), 10 used") in m.notes_
+    assert "note: rsj final_deformation_cm: 2 of 12" in m.report()
+
+
+def test_an_input_missing_from_the_table_is_noted_and_a_query_setting_it_refused(grid_table):
+    m = SweepSurrogate(targets=("final_deformation_cm",), n_restarts=0).fit(grid_table.drop(columns=["diameter_mm"]))
+    assert any("no column diameter_mm" in n for n in m.notes_)
+    query = {"scope": "sdc", "friction": 0.0}
+    m.predict(query, "rsj")  # without the input: answered
+    with pytest.raises(ColonsimError, match="fitted on a table without diameter_mm"):
+        m.predict({**query, "diameter_mm": 23.0}, "rsj")
+    # a batch whose diameter column is empty sets nothing
+    out = m.predict_frame(pd.DataFrame({"segment": ["rsj"], "scope": ["sdc"], "friction": [0.0], "diameter_mm": [np.nan]}))
+    assert np.isfinite(out["final_deformation_cm"]).all()
+
+
+def test_a_failed_save_leaves_the_earlier_model_untouched(model, tmp_path):
+    """Both files are written and read back before either replaces the earlier pair."""
+    json_path, npz_path = save_surrogate(model, tmp_path / "model")
+    before = {p.name: p.read_bytes() for p in tmp_path.iterdir()}
+    broken = SweepSurrogate(targets=TARGETS, n_restarts=0).fit(synthetic_sweep(design="grid", noise_cm=0.05, seed=2))
+    broken.cv_["rsj"]["final_deformation_cm"]["rmse"] = float("inf")  # a value JSON cannot hold
+    for path in (tmp_path / "model", tmp_path / "fresh"):
+        with pytest.raises(ColonsimError, match=r"cross_validation.rmse is inf, which JSON cannot hold"):
+            save_surrogate(broken, path)
+    assert {p.name: p.read_bytes() for p in tmp_path.iterdir()} == before  # no stray .npz, nothing replaced
+    load_surrogate(json_path)
+
+
+def test_outputs_that_overflow_the_fit_are_refused():
+    table = synthetic_sweep(n_runs=12, segments=("rsj",), n_failed=0, seed=4)
+    table.loc[3, "final_deformation_cm"] = 1e300
+    with pytest.raises(ColonsimError, match="rsj final_deformation_cm: the fit is not finite"):
+        SweepSurrogate(targets=("final_deformation_cm",), n_restarts=0).fit(table)
+
+
 def test_varying_solver_setting_is_noted():
     table = synthetic_sweep(n_runs=10, segments=("rsj",), seed=2)
     table.loc[::2, "element_size_mm"] = 4.0

@@ -80,8 +80,30 @@ def test_smoke_sweep_on_a_dask_local_cluster(tmp_path):
     assert (again.ran, again.skipped) == (0, 3)
 
 
+def _children(pid):
+    """Processes whose parent is ``pid`` (Linux /proc)."""
+    found = []
+    for stat in Path("/proc").glob("[0-9]*/stat"):
+        try:
+            fields = stat.read_text().rsplit(")", 1)[1].split()
+        except OSError:  # exited meanwhile
+            continue
+        if int(fields[1]) == pid:
+            found.append(int(stat.parent.name))
+    return found
+
+
+def _running(pid):
+    try:
+        return Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0] != "Z"
+    except OSError:
+        return False
+
+
+@pytest.mark.skipif(not Path("/proc/self/stat").is_file(), reason="reads the process table from /proc")
 def test_a_killed_sweep_resumes_where_it_stopped(tmp_path):
-    """Kill the whole sweep (parent and workers) after its first recorded run; rerun: done runs are skipped."""
+    """SIGKILL the sweep's main process (what the out-of-memory killer does) after its first
+    recorded run: its workers exit within seconds; a rerun skips the runs already done."""
     out = tmp_path / "killed"
     env = {**os.environ, "NUMBA_NUM_THREADS": "1", "PYTHONPATH": os.pathsep.join([str(ROOT), os.environ.get("PYTHONPATH", "")])}
     proc = subprocess.Popen([sys.executable, "-m", "colonsim.cli", "sweep", "--preset", "smoke", "--workers", "1",
@@ -93,8 +115,19 @@ def test_a_killed_sweep_resumes_where_it_stopped(tmp_path):
             assert proc.poll() is None, proc.stderr.read().decode()
             assert time.monotonic() < deadline, "the sweep recorded no run in 240 s"
             time.sleep(0.05)
+        workers = _children(proc.pid)
+        assert workers
+        proc.kill()  # the main process only
+        proc.wait()
+        deadline = time.monotonic() + 10
+        while any(_running(w) for w in workers) and time.monotonic() < deadline:
+            time.sleep(0.1)
+        assert not [w for w in workers if _running(w)], "worker processes outlived their sweep"
     finally:
-        os.killpg(proc.pid, signal.SIGKILL)
+        try:
+            os.killpg(proc.pid, signal.SIGKILL)  # whatever is left (nothing, if the test passed)
+        except ProcessLookupError:
+            pass
         proc.wait()
     before = pd.read_parquet(out / TABLE)
     assert 1 <= len(before) < 3 and (before["status"] == "ok").all()
@@ -143,6 +176,30 @@ def test_store_rows_follow_the_contract_and_the_table_is_replaced_atomically(tmp
     with SweepStore(tmp_path) as store:
         assert set(store.rows) == {case.key()}
         assert list(store.table().columns[:len(IDENTITY)]) == list(IDENTITY)
+
+
+def test_a_folder_holds_one_sweep(tmp_path):
+    """Resuming the same sweep is allowed (same cases, or the same TOML text after the case fields
+    changed); another sweep is refused, also into a folder without sweep.json."""
+    from colonsim.errors import ColonsimError
+    from insertion.sweep_spec import parse_sweep
+
+    a = parse_sweep('[sweep]\nname = "a"\n[[grid]]\nsegment = "straight"\nscope = ["utc", "sdc"]\n')
+    b = parse_sweep('[sweep]\nname = "b"\n[[grid]]\nsegment = "straight"\nscope = ["pdc"]\n')
+    outcome = {"status": "failed", "error": "x", "wall_time_s": 1.0, "finished_at": "2026-01-01T00:00:00+00:00"}
+    with SweepStore(tmp_path) as store:
+        store.record(a.cases[0], {**outcome, "key": a.cases[0].key()})
+        store.check_same_sweep([c.key() for c in a.cases])  # no sweep.json: the rows are of this sweep
+        with pytest.raises(ColonsimError, match="holds another sweep of 1 runs"):
+            store.check_same_sweep([c.key() for c in b.cases])
+    (tmp_path / "sweep.json").write_text(__import__("json").dumps(a.document()))
+    with SweepStore(tmp_path) as store:
+        store.check_same_sweep([c.key() for c in a.cases], a.source)
+        store.check_same_sweep(["other keys"], a.source)  # same TOML, keys of a newer InsertionCase
+        with pytest.raises(ColonsimError, match=r"holds another sweep \('a'\) of 2 runs \(1 recorded, 0 in common"):
+            store.check_same_sweep([c.key() for c in b.cases], b.source)
+        with pytest.raises(ColonsimError, match="another sweep"):
+            store.check_same_sweep([a.cases[0].key()])  # a part of it is another sweep too
 
 
 def test_an_unreachable_scheduler_fails_before_anything_is_written(tmp_path):

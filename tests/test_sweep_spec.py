@@ -129,7 +129,7 @@ def test_material_paths_are_read_from_the_toml_folder(tmp_path):
     ("[lhs]\nsamples = 0\nfriction = [0, 0.1]", "samples = 0"),
     ("[lhs]\nsamples = 3\nfriction = [0.1, 0]", "low < high"),
     ('[lhs]\nsamples = 3\nsegment = [1, 2]', "not a continuous input"),
-    ('[fixed]\nmaterial = "absent.json"', "not found"),
+    ('[fixed]\nmaterial = "absent.json"\n[grid]\nscope = "utc"', "not found"),
     ("[grid\n", "not valid TOML"),
     ("", "describes no runs"),
 ])
@@ -142,8 +142,8 @@ def test_bad_descriptions_raise_one_actionable_line(text, message):
 def test_field_list_comes_from_the_dataclass():
     """A field added to InsertionCase is a valid sweep key without touching the sweep code."""
     every = {f.name: f.default for f in dataclasses.fields(InsertionCase)}
-    text = "[fixed]\n" + "\n".join(f"{k} = {json.dumps(v)}" for k, v in every.items()
-                                   if v is not None and k not in ("scope", "segment"))
+    text = "[[grid]]\n" + "\n".join(f"{k} = {json.dumps(v)}" for k, v in every.items()
+                                    if v is not None and k not in ("scope", "segment"))
     assert parse_sweep(text).cases[0].key() == InsertionCase().key()
 
 

@@ -1,0 +1,57 @@
+"""Value types of the command-line options: numbers that must be finite, outputs checked at once.
+
+Each turns a bad value into an argparse error (one line, exit code 2, see
+:class:`colonsim.cli.OneLineParser`) while the options are read, so that nothing starts on input
+that would fail later; output paths are checked by :mod:`colonsim.files`.
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+
+from colonsim.errors import ColonsimError
+from colonsim.files import check_output_file, check_output_folder
+
+
+def finite_float(text) -> float:
+    """A finite number (``inf``, ``nan`` and overflowing values such as 1e999 are refused)."""
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a number") from None
+    if not math.isfinite(value):
+        raise argparse.ArgumentTypeError(f"{text!r} is not a finite number")
+    return value
+
+
+def positive_int(text) -> int:
+    """A whole number >= 1."""
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a whole number") from None
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"{value} must be at least 1")
+    return value
+
+
+def _checked(check, text, *args):
+    try:
+        return check(text, "", *args)
+    except ColonsimError as exc:
+        raise argparse.ArgumentTypeError(str(exc).strip()) from None
+
+
+def output_folder(text):
+    """A folder to write results into (new, or an earlier run's), checked before any work."""
+    return _checked(check_output_folder, text)
+
+
+def output_file(*suffixes):
+    """A type for a file to write, checked before any work; ``suffixes`` (e.g. ".png") if given."""
+    def file_type(text):
+        return _checked(check_output_file, text, suffixes or None)
+
+    file_type.__name__ = "output file"
+    return file_type
