@@ -61,7 +61,7 @@ def insertion_step(material: Path, element_size: float, out: Path, show: bool):
     from insertion.scenario import InsertionCase
 
     _section("2/5 RSJ insertions (D = 36 mm, mu = 0) of the three scopes with the calibrated material; "
-             "docs/validation_rsj.md compares this model with the source")
+             "docs/validation/report.md compares this model with the source")
     import numba
 
     # One thread: on a 2-core machine with anything else running, two Numba threads wait on each

@@ -32,3 +32,15 @@ def source_rsj_table() -> pd.DataFrame:
     return pd.DataFrame([{"segment": "rsj", "scope": scope, "diameter_mm": d, "friction": 0.0, "angle_deg": 0.0,
                           "point_A_cm": v["A"], "point_C_cm": v["C"], "final_deformation_cm": v["C"], "status": "ok"}
                          for (scope, d), v in SOURCE_RSJ_CM.items()])
+
+# Wall nodes and triangles of the source's colon meshes (None: not given), per (segment, colon
+# diameter mm, angle deg).
+SOURCE_MESHES = {
+    ("rsj", 23.0, 0.0): (2064, 4076),
+    ("rsj", 36.0, 0.0): (2792, 5504),
+    ("rsf", 36.0, 0.0): (6632, 13188),
+    ("thf", 36.0, 0.0): (4086, 7832),
+    ("thf", 36.0, 30.0): (5324, None),
+    ("thf", 36.0, 45.0): (5977, None),
+}
+

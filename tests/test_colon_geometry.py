@@ -7,6 +7,7 @@ from colonsim.errors import ColonsimError
 from insertion.centerline import (Arc, Centerline, Kink, Straight, rsf_centerline, rsj_centerline, thf_centerline,
                                   thf_fixed_centerline)
 from insertion.colon_geometry import enclosed_volume, tube_mesh
+from insertion.reference import SOURCE_MESHES
 from insertion.sheet_mesh import hinges
 
 H = 3e-3
@@ -132,14 +133,9 @@ def test_tags_and_end_rings():
     assert not tube_mesh(thf_fixed_centerline(30.0), 0.036, H).mobile.any()
 
 
-SOURCE = {  # the source's colon meshes (nodes, triangles; None: not given)
-    "RSJ D23": (rsj_centerline, 0.023, 2064, 4076),
-    "RSJ D36": (rsj_centerline, 0.036, 2792, 5504),
-    "RSF alpha 0": (lambda: rsf_centerline(0.0), 0.036, 6632, 13188),
-    "THF beta 0": (lambda: thf_centerline(0.0), 0.036, 4086, 7832),
-    "THF beta 30": (lambda: thf_centerline(30.0), 0.036, 5324, None),
-    "THF beta 45": (lambda: thf_centerline(45.0), 0.036, 5977, None),
-}
+BUILDERS = {"rsj": lambda angle: rsj_centerline(), "rsf": rsf_centerline, "thf": thf_centerline}
+SOURCE = {f"{segment.upper()} D{d:g} angle {a:g}": (lambda a=a, b=BUILDERS[segment]: b(a), d * 1e-3, *counts)
+          for (segment, d, a), counts in SOURCE_MESHES.items()}
 
 
 @pytest.mark.parametrize("name", SOURCE)
