@@ -59,3 +59,21 @@ def save_figure(fig, path, dpi=150):
     so no GUI backend is involved and nothing needs closing)."""
     with atomic_path(path) as tmp:
         fig.savefig(tmp, dpi=dpi, bbox_inches="tight")
+
+
+def check_output_folder(path, option="--out"):
+    """Refuse, before any work, an output folder that cannot be one: an existing regular file, a
+    path through a file, or a place without write permission."""
+    from colonsim.errors import ColonsimError
+
+    path = Path(path)
+    if path.exists() and not path.is_dir():
+        raise ColonsimError(f"{option} {path} is an existing file, not a folder; choose a folder path")
+    existing = path
+    while not existing.exists():
+        existing = existing.parent
+    if not existing.is_dir():
+        raise ColonsimError(f"{option} {path}: {existing} is a file, so no folder can be made under it; "
+                            "choose another path")
+    if not os.access(existing, os.W_OK | os.X_OK):
+        raise ColonsimError(f"{option} {path}: no permission to write in {existing}; choose another path")
