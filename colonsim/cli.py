@@ -39,18 +39,22 @@ def _add_calibrate(sub):
     src = p.add_argument_group("test data (default: the bundled synthetic data set)")
     src.add_argument("--manifest", type=Path,
                      help="CSV listing specimens: specimen,file,length_mm,width_mm,thickness_mm")
-    src.add_argument("--curve", type=Path, help="one force-displacement CSV (give --length, --width, --thickness)")
-    src.add_argument("--length", type=float, help="free length between the grips, mm")
-    src.add_argument("--width", type=float, help="specimen width, mm")
-    src.add_argument("--thickness", type=float, help="wall thickness, mm")
+    src.add_argument("--curve", type=Path,
+                     help="one force-displacement CSV or testing-machine export (geometry from --length, --width, "
+                          "--thickness or the file's preamble)")
+    src.add_argument("--length", type=float, help="free length between the grips, mm (wins over the file's preamble)")
+    src.add_argument("--width", type=float, help="specimen width, mm (wins over the file's preamble)")
+    src.add_argument("--thickness", type=float, help="wall thickness, mm (wins over the file's preamble)")
     src.add_argument("--displacement-unit", help="unit of the displacement column if the header does not say (mm, m, cm, um, in)")
     src.add_argument("--force-unit", help="unit of the force column if the header does not say (N, mN, kN, gf, kgf, lbf)")
     fit = p.add_argument_group("fit")
     fit.add_argument("--per-specimen", action="store_true",
                      help="fit every specimen separately and report the population mean and spread "
                           "(default: fit the mean curve of all specimens, the source's way)")
-    fit.add_argument("--law", default="mooney_rivlin_3",
-                     help="mooney_rivlin_3 (default, SPEC.md 1.2), mooney_rivlin_2, neo_hookean, yeoh")
+    fit.add_argument("--law", help="mooney_rivlin_3 (default), mooney_rivlin_2, neo_hookean, yeoh")
+    fit.add_argument("--compare-laws", action="store_true",
+                     help="fit every law the insertion solver runs, write laws.csv and laws.png, and material.json "
+                          "for the law BIC chooses")
     fit.add_argument("--analytic", action="store_true",
                      help="fit the closed-form homogeneous uniaxial model instead of the clamped FE strip")
     fit.add_argument("--mesh", type=_mesh, default=(8, 3), help="FE divisions of the quarter strip, default 8x3")
@@ -59,28 +63,45 @@ def _add_calibrate(sub):
                      help="reduced budget (40 designs, 100 CMA-ES, 160 Nelder-Mead evaluations) instead of 100/300/300")
     fit.add_argument("--seed", type=int, default=1, help="seed of the Latin hypercube and CMA-ES (default 1)")
     fit.add_argument("--workers", type=int, default=2, help="processes for --per-specimen (default 2)")
-    p.add_argument("--out", type=Path, default=Path("colonsim_results/calibration"),
+    p.add_argument("--out", type=output_folder, default="colonsim_results/calibration",
                    help="output folder (default colonsim_results/calibration)")
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
     p.set_defaults(func=cmd_calibrate)
 
 
 def _load_curves(args):
-    from identification.testdata import read_curve, read_manifest
+    """The curves named by ``args``; what the reader noticed is printed as ``colonsim: warning:``
+    lines, and geometry taken from a file's preamble is said."""
+    import warnings
+
+    from identification.testdata import CurveWarning, read_curve, read_manifest
 
     units = {"displacement_unit": args.displacement_unit, "force_unit": args.force_unit}
     if args.curve and args.manifest:
         raise ColonsimError("give either --curve or --manifest, not both")
-    if args.curve:
-        return [read_curve(args.curve, *(None if v is None else v * 1e-3 for v in (args.length, args.width, args.thickness)),
-                           **units)]
-    if any(v is not None for v in (args.length, args.width, args.thickness)):
+    if not args.curve and any(v is not None for v in (args.length, args.width, args.thickness)):
         raise ColonsimError("--length/--width/--thickness go with --curve; a manifest has its own geometry columns")
     manifest = args.manifest or BUNDLED_MANIFEST
-    if args.manifest is None and not manifest.is_file():
+    if not args.curve and args.manifest is None and not manifest.is_file():
         raise ColonsimError(f"the bundled data set {manifest} is missing (install from a clone of the repository) "
                             "or pass --manifest/--curve")
-    return read_manifest(manifest, **units)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always", CurveWarning)
+        if args.curve:
+            curves = [read_curve(args.curve, *(None if v is None else v * 1e-3 for v in (args.length, args.width, args.thickness)),
+                                 given_as="--{}", **units)]
+        else:
+            curves = read_manifest(manifest, **units)
+    for w in caught:
+        print(f"colonsim: warning: {w.message}", file=sys.stderr)
+    for c in curves:
+        notes = [f"{q} from the {src}" for q, src in c.meta.get("geometry_from", {}).items() if src.startswith("preamble")]
+        ignored = c.meta.get("layout", {}).get("rows_after_data_ignored")
+        if ignored:
+            notes.append(f"{ignored} rows after the data ignored (from line {c.meta['layout']['first_ignored_line']})")
+        if notes:
+            print(f"{c.name}: {'; '.join(notes)}", flush=True)
+    return curves
 
 
 class _Progress:
@@ -106,9 +127,10 @@ class _Progress:
 
 
 def _format_result(r) -> str:
-    from identification.report import material_document
+    from identification.diagnostics import split_unidentified
+    from identification.report import small_strain
+    from insertion.material import solver_law_gap
 
-    doc = material_document(r)
     unc, ci = r.uncertainty, r.uncertainty.interval()
     lines = [f"{r.curve.name}: {r.model['model']}, law {r.model['law']}"]
     for i, n in enumerate(r.names):
@@ -117,35 +139,68 @@ def _format_result(r) -> str:
     pairs = ", ".join(f"{r.names[i]}/{r.names[j]} {corr[i, j]:+.3f}" for i in range(len(r.names)) for j in range(i + 1, len(r.names)))
     if pairs:
         lines.append(f"  correlation: {pairs}")
-    ss = doc["small_strain"]
-    if ss["mu0_sd_Pa"] is not None:
-        lines.append(f"  mu0 = 2 (C10 + C01) = {ss['mu0_Pa']:.1f} Pa, sd {ss['mu0_sd_Pa']:.1f} (well identified even when the split is not)")
+    split = split_unidentified(r)
+    if split is not None:
+        lines.append(f"  the C10/C01 split is not identified by uniaxial data (correlation {split:+.3f}); mu0 carries their sum")
+    ss = small_strain(r)
+    lines.append(f"  mu0 = {ss['mu0_Pa']:.1f} Pa, sd {ss['mu0_sd_Pa']:.1f} from the noise: {ss['identification']}")
+    mf = ss["model_form"]
+    if mf is not None:
+        share = f" = {abs(mf['difference_in_noise_sd']):.1f} noise sd" if mf["difference_in_noise_sd"] is not None else ""
+        lines.append(f"  model form: mu0 {mf['mu0_clamped_fe_Pa']:.1f} Pa (clamped FE) vs {mf['mu0_closed_form_Pa']:.1f} Pa "
+                     f"(closed form), the clamp shifts mu0 by {mf['difference_Pa']:+.1f} Pa{share}")
     st = r.stages
     lines.append(f"  objective e1: initial {st['initial']['e1']:.4g} -> sensitivity {st['sensitivity']['e1']:.4g} -> "
                  f"CMA-ES {st['cma-es']['e1']:.4g} -> Nelder-Mead {st['nelder-mead']['e1']:.4g} N^2")
-    lines.append(f"  fit: RMS {r.fit['rms_N']:.4f} N, max {r.fit['max_abs_N']:.4f} N, R^2 {r.fit['r2']:.6f} "
+    r2 = f", R^2 {r.fit['r2']:.6f}" if r.fit["r2"] is not None else ""
+    lines.append(f"  fit: RMS {r.fit['rms_N']:.4f} N = {r.fit['rms_over_noise']:.2f} x the curve's noise "
+                 f"({r.fit['noise_sd_N']:.4f} N per sample), max {r.fit['max_abs_N']:.4f} N{r2} "
                  f"({r.fit['evaluations']} evaluations, {r.fit['wall_time_s']:.1f} s)")
     mc = r.model_comparison
-    lines.append(f"  clamped FE vs closed form at these parameters: {100 * mc['fe_over_closed_form_minus_1_min']:+.2f} % to "
-                 f"{100 * mc['fe_over_closed_form_minus_1_max']:+.2f} % in force (end: {mc['force_end_fe_N']:.3f} vs "
-                 f"{mc['force_end_closed_form_N']:.3f} N)")
+    if "unavailable" in mc:
+        lines.append(f"  clamped FE vs closed form: {mc['unavailable']}")
+    else:
+        lines.append(f"  clamped FE vs closed form at these parameters: {100 * mc['fe_over_closed_form_minus_1_min']:+.2f} % "
+                     f"to {100 * mc['fe_over_closed_form_minus_1_max']:+.2f} % in force (end: {mc['force_end_fe_N']:.3f} vs "
+                     f"{mc['force_end_closed_form_N']:.3f} N)")
+    gap = solver_law_gap(r.model["law"])
+    if gap:
+        lines.append(f"  note: {gap}; this material.json is for comparison only")
     return "\n".join(lines)
+
+
+def _print_warnings(results):
+    from identification.diagnostics import misfit_warning
+
+    for r in results:
+        warning = misfit_warning(r)
+        if warning:
+            print(f"colonsim: warning: {warning}", file=sys.stderr, flush=True)
 
 
 def run_calibration(args, out: Path) -> list:
     """Load the curves named by ``args``, calibrate, write results into ``out``; return the results."""
+    from colonsim.files import check_output_folder
     from identification.laws import get_law
     from identification.pipeline import Budget
     from identification.population import calibrate_curve, calibrate_specimens, population_summary, population_table, write_population
     from identification.report import write_calibration
     from identification.testdata import mean_curve
 
-    get_law(args.law)
+    check_output_folder(out)
+    if args.compare_laws and args.law is not None:
+        raise ColonsimError(f"--compare-laws fits every law the insertion solver runs; drop --law {args.law}")
+    if args.compare_laws and args.per_specimen:
+        raise ColonsimError("--compare-laws fits one curve (or the mean curve); drop --per-specimen")
+    law = args.law or "mooney_rivlin_3"
+    get_law(law)
     if args.points < 5:
         raise ColonsimError(f"--points {args.points} is too few to fit 3 parameters; use at least 5 (default 20)")
+    if args.workers < 1:
+        raise ColonsimError(f"--workers {args.workers}; give at least 1")
     curves = _load_curves(args)
     budget = Budget.quick() if args.quick else Budget()
-    options = dict(law=args.law, analytic=args.analytic, budget=budget, seed=args.seed, n_points=args.points)
+    options = dict(law=law, analytic=args.analytic, budget=budget, seed=args.seed, n_points=args.points)
     if not args.analytic:
         options.update(n_length=args.mesh[0], n_width=args.mesh[1])
     per_eval = 1 + budget.designs + budget.cma_max_evaluations + budget.cma_popsize + budget.nm_max_evaluations
@@ -163,6 +218,7 @@ def run_calibration(args, out: Path) -> list:
         paths = write_population(results, out)
         for r in results:
             print(_format_result(r))
+        _print_warnings(results)
         summary = population_summary(population_table(results), results[0].names)
         print("population (between-specimen mean +- sd):")
         for n, s in summary.items():
@@ -173,6 +229,8 @@ def run_calibration(args, out: Path) -> list:
     if len(curves) > 1:
         print(f"fitting the mean curve of {len(curves)} specimens (mean thickness {curve.thickness * 1e3:.3f} mm; "
               "--per-specimen fits each one)", flush=True)
+    if args.compare_laws:
+        return _compare_laws(curve, options, per_eval, show, out)
     bar = _Progress(per_eval, "eval", show)
     try:
         result = calibrate_curve(curve, progress=lambda stage, n, e1: bar.evaluation(curve.name, stage, n, e1), **options)
@@ -180,8 +238,41 @@ def run_calibration(args, out: Path) -> list:
         bar.close()
     paths = write_calibration(result, out)
     print(_format_result(result))
+    _print_warnings([result])
     print(f"results: {paths['material']} (+ history.csv, sensitivity.csv, top10_designs.csv, fit.csv, *.png in {out}/)")
     return [result]
+
+
+def _compare_laws(curve, options, per_eval, show, out: Path) -> list:
+    """``calibrate --compare-laws``: every law the solver runs on ``curve``, BIC chooses."""
+    import pandas as pd
+
+    from identification.law_comparison import compare_laws, write_law_comparison
+    from identification.population import calibrate_curve
+    from insertion.material import SOLVER_LAWS
+
+    bar = _Progress(per_eval * len(SOLVER_LAWS), "eval", show)
+
+    def fit(law):
+        return calibrate_curve(curve, progress=lambda stage, n, e1: bar.evaluation(f"{curve.name} {law}", stage, n, e1),
+                               **{**options, "law": law})
+
+    try:
+        comparison = compare_laws(fit)
+    finally:
+        bar.close()
+    paths = write_law_comparison(comparison, out)
+    shown = comparison.table.drop(columns=["fitted", "note"]).set_index("law")
+    with pd.option_context("display.width", 200, "display.max_columns", 30):
+        print(shown.to_string(float_format=lambda v: f"{v:.4g}", na_rep="-"))
+    for law, why in comparison.left_out.items():
+        print(f"left out {law}: {why}")
+    print(f"chosen: {comparison.chosen}, {comparison.reason}")
+    print(_format_result(comparison.chosen_result))
+    _print_warnings([comparison.chosen_result])
+    print(f"results: {paths['material']} ({comparison.chosen}), {paths['laws_table']}, {paths['laws_plot']}; "
+          f"every law's calibration files in {out}/laws/")
+    return [comparison.chosen_result]
 
 
 def cmd_calibrate(args):

@@ -51,7 +51,7 @@ def calibrate_step(out: Path, show: bool):
              "reduced budget (--quick)")
     args = argparse.Namespace(manifest=None, curve=None, length=None, width=None, thickness=None,
                               displacement_unit=None, force_unit=None, per_specimen=False, law="mooney_rivlin_3",
-                              analytic=False, mesh=(8, 3), points=20, quick=True, seed=1, workers=1,
+                              compare_laws=False, analytic=False, mesh=(8, 3), points=20, quick=True, seed=1, workers=1,
                               no_progress=not show)
     return run_calibration(args, out)[0]
 

@@ -23,29 +23,48 @@ from matplotlib.figure import Figure
 
 from colonsim.files import save_figure, write_csv, write_json
 from colonsim.provenance import code_version
+from identification.diagnostics import identification_words, misfit_warning, shear_modulus
 from identification.laws import get_law
 from identification.pipeline import CalibrationResult
+from identification.testdata import source_records
+from insertion.material import solver_law_gap
 
 MATERIAL_FORMAT = "colonsim-material/1"
 _STAGE_COLOURS = {"initial": "k", "sensitivity": "tab:gray", "cma-es": "tab:blue", "nelder-mead": "tab:red"}
 
 
-def material_document(result: CalibrationResult, level=0.95) -> dict:
-    """The ``material.json`` document of one calibration (read by :mod:`insertion.material`)."""
+def small_strain(result: CalibrationResult) -> dict:
+    """mu0 with its noise-only sd, how well that identifies it, and the model-form share beside it:
+    mu0 as the clamped FE strip and as the closed form identify it from the same curve."""
+    mu0, mu0_sd = shear_modulus(result)
+    mc = result.model_comparison
+    fe, cf = mc.get("mu0_clamped_fe_Pa"), mc.get("mu0_closed_form_Pa")
+    model_form = None
+    if fe is not None and cf is not None:
+        model_form = {"mu0_clamped_fe_Pa": fe, "mu0_closed_form_Pa": cf, "difference_Pa": fe - cf,
+                      "difference_in_noise_sd": (fe - cf) / mu0_sd if mu0_sd > 0 else None,
+                      "how": mc["mu0_refit"]}
+    return {"mu0_Pa": mu0, "mu0_sd_Pa": mu0_sd, "E0_Pa": 3.0 * mu0, "mu0_sd_covers": "measurement noise only",
+            "identification": identification_words(mu0, mu0_sd, result.fit["follows_curve"]),
+            "model_form": model_form}
+
+
+def material_document(result: CalibrationResult, level=0.95, selection=None) -> dict:
+    """The ``material.json`` document of one calibration (read by :mod:`insertion.material`);
+    ``selection`` records why this law was chosen when several were compared."""
     law = get_law(result.model["law"])
     unc = result.uncertainty.to_dict(level)
-    mu0 = law.initial_shear_modulus(result.parameters)
-    # Only C10 + C01 enters mu0, so its uncertainty comes from the covariance of the sum.
-    weights = np.array([1.0 if n in ("C10", "C01") else 0.0 for n in result.names])
-    mu0_sd = 2.0 * result.uncertainty.linear_combination_std(weights) if law.name.startswith("mooney") else None
-    return {
+    warning = misfit_warning(result)
+    document = {
         "format": MATERIAL_FORMAT,
         "law": law.name,
         "description": f"Identified by colonsim calibrate from {result.curve.name} "
                        f"({result.model['model']}).",
         "units": "Pa",
         "parameters": result.parameter_dict,
-        "small_strain": {"mu0_Pa": mu0, "mu0_sd_Pa": mu0_sd, "E0_Pa": 3.0 * mu0},
+        "insertion_solver": solver_law_gap(law.name) or "runs this law",
+        "small_strain": small_strain(result),
+        "warnings": [warning] if warning else [],
         "uncertainty": {k: unc[k] for k in unc if k not in ("correlation", "covariance")},
         "correlation": {"names": list(result.names), "matrix": unc["correlation"]},
         "covariance_Pa2": unc["covariance"],
@@ -55,11 +74,14 @@ def material_document(result: CalibrationResult, level=0.95) -> dict:
         "model_comparison": result.model_comparison,
         "specimen": {"name": result.curve.name, "length_mm": result.curve.length * 1e3,
                      "width_mm": result.curve.width * 1e3, "thickness_mm": result.curve.thickness * 1e3,
-                     **result.curve.meta},
+                     **{k: v for k, v in result.curve.meta.items() if k in ("path", "averaged_specimens")}},
         "provenance": {"tool": "colonsim calibrate", **code_version(),
                        "date": _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds"),
-                       **result.settings},
+                       **result.settings, "source_files": source_records(result.curve)},
     }
+    if selection is not None:
+        document["law_selection"] = selection
+    return document
 
 
 def top_designs(result: CalibrationResult, n=10) -> pd.DataFrame:
@@ -122,14 +144,15 @@ def fit_figure(result: CalibrationResult) -> Figure:
     return fig
 
 
-def write_calibration(result: CalibrationResult, out_dir) -> dict:
-    """Write the files of one calibration into ``out_dir``; return their paths."""
+def write_calibration(result: CalibrationResult, out_dir, selection=None) -> dict:
+    """Write the files of one calibration into ``out_dir``; return their paths (``selection``: see
+    :func:`material_document`)."""
     out = Path(out_dir)
     paths = {"material": out / "material.json", "history": out / "history.csv",
              "sensitivity": out / "sensitivity.csv", "top10": out / "top10_designs.csv", "fit": out / "fit.csv",
              "sensitivity_plot": out / "sensitivity.png", "objective_plot": out / "objective.png",
              "fit_plot": out / "fit.png"}
-    write_json(paths["material"], material_document(result))
+    write_json(paths["material"], material_document(result, selection=selection))
     write_csv(paths["history"], result.history)
     write_csv(paths["sensitivity"], result.sensitivity.rename_axis("parameter").reset_index())
     write_csv(paths["top10"], top_designs(result))

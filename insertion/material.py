@@ -1,8 +1,9 @@
 """Colon wall material: the incompressible three-parameter Mooney-Rivlin law read from JSON.
 
-The calibration workflow writes a material file (``"law": "mooney_rivlin_3"``, parameters in Pa);
-the insertion model reads it here. A reference copy holding the source's identified parameters
-ships with the repository (:data:`REFERENCE_MATERIAL_PATH`).
+The calibration workflow writes a material file (``"law": "mooney_rivlin_3"`` or one of the
+other :data:`SOLVER_LAWS`, parameters in Pa); the insertion model reads it here. A reference copy
+holding the source's identified parameters ships with the repository
+(:data:`REFERENCE_MATERIAL_PATH`).
 """
 
 import json
@@ -12,9 +13,14 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from colonsim.errors import ColonsimError, ColonsimWarning
+from identification.laws import get_law
 
 LAW = "mooney_rivlin_3"
 PARAMETER_NAMES = ("C10", "C01", "C11")
+# The calibrated laws the wall model runs. It is the three-parameter Mooney-Rivlin, so a law runs
+# when it is a special case of it: the parameters it lacks are zero. ``colonsim calibrate
+# --compare-laws`` fits exactly these; a law of another form (yeoh) needs its own wall model first.
+SOLVER_LAWS = ("mooney_rivlin_3", "mooney_rivlin_2", "neo_hookean")
 # Small-strain shear modulus below which a wall is softer than any soft tissue: the softest
 # (brain, fat) are near 1 kPa, the reference colon wall 87 kPa. Below this, parameters were most
 # likely given in the wrong unit.
@@ -23,6 +29,14 @@ SOFTEST_TISSUE_MU0_PA = 100.0
 
 class SoftWallWarning(ColonsimWarning):
     """A wall material softer than any soft tissue (probably parameters in the wrong unit)."""
+
+
+def solver_law_gap(law):
+    """Why the insertion solver cannot run ``law`` (None when it can)."""
+    if law in SOLVER_LAWS:
+        return None
+    return (f"the insertion solver's wall law is {LAW}; {law} is not a special case of it (the solver runs "
+            f"{', '.join(SOLVER_LAWS)})")
 
 
 def _reference_material_path():
@@ -103,13 +117,14 @@ class MooneyRivlin:
 
 
 def load_material(path):
-    """Read a ``mooney_rivlin_3`` material file.
+    """Read a material file of one of the :data:`SOLVER_LAWS`.
 
     Parameters
     ----------
     path : str or Path
-        JSON file with ``"law": "mooney_rivlin_3"``, ``"units": "Pa"`` and
-        ``"parameters": {"C10": .., "C01": .., "C11": ..}``.
+        JSON file with ``"law"`` (e.g. ``"mooney_rivlin_3"``), ``"units": "Pa"`` and
+        ``"parameters"`` of that law (``{"C10": .., "C01": .., "C11": ..}``); the Mooney-Rivlin
+        parameters a simpler law lacks are zero.
 
     Returns
     -------
@@ -138,11 +153,12 @@ def load_material(path):
             "fix or regenerate the file."
         )
     law = data.get("law")
-    if law != LAW:
+    if law not in SOLVER_LAWS:
         raise ColonsimError(
-            f"material file {path} has law {law!r}; only {LAW!r} is supported, "
-            "recalibrate with that law."
+            f"material file {path} has law {law!r}; the insertion solver runs {', '.join(SOLVER_LAWS)}: "
+            "recalibrate with one of them."
         )
+    names = get_law(law).parameter_names
     units = data.get("units", "Pa")
     if units != "Pa":
         raise ColonsimError(
@@ -152,17 +168,23 @@ def load_material(path):
     params = data.get("parameters")
     if not isinstance(params, dict):
         raise ColonsimError(
-            f"material file {path} lacks a 'parameters' object with C10, C01, C11 in Pa; "
+            f"material file {path} lacks a 'parameters' object with {', '.join(names)} in Pa; "
             "fix or regenerate the file."
         )
-    missing = [name for name in PARAMETER_NAMES if name not in params]
+    missing = [name for name in names if name not in params]
     if missing:
         raise ColonsimError(
             f"material file {path} misses parameter(s) {', '.join(missing)}; "
-            "give C10, C01 and C11 in Pa."
+            f"give {', '.join(names)} in Pa."
+        )
+    foreign = [name for name in params if name not in names]
+    if foreign:
+        raise ColonsimError(
+            f"material file {path}: parameter(s) {', '.join(foreign)} do not belong to law {law}; "
+            f"give only {', '.join(names)} or change the law."
         )
     try:
-        material = MooneyRivlin(*(params[name] for name in PARAMETER_NAMES))
+        material = MooneyRivlin(*(params.get(name, 0.0) for name in PARAMETER_NAMES))
     except ColonsimError as exc:
         raise ColonsimError(f"material file {path}: {exc}") from None
     if material.mu0 < SOFTEST_TISSUE_MU0_PA:
