@@ -119,16 +119,17 @@ def test_constant_depth_is_no_jam():
     assert not jammed(z, np.minimum(z, 0.03), force)
 
 
-@pytest.mark.parametrize("trend, jam", [(50.0, True), (-50.0, False)])
-def test_ringing_force_is_judged_by_its_half_window_means(trend, jam):
+@pytest.mark.parametrize("trend, jam", [(1000.0, True), (50.0, False), (-50.0, False)])
+def test_ringing_force_is_judged_by_a_rise_that_stands_out_of_it(trend, jam):
     """The drive reaction rings: 5 N at a period of 2/21 cm of push (10.5 periods in the window), on a
-    trend of +-50 N/m (+-0.5 N between the half-window means; the ringing's own means differ by 0.3 N)."""
+    trend of 1000 N/m (20 N over the window: a tip held by the wall) or +-50 N/m (+-0.5 N between the
+    half-window means, within the ringing: a scope bowing into a wide lumen)."""
     period = 0.02 / 10.5
     force = 20.0 + trend * (PUSH - 0.02) + 5.0 * np.cos(2 * np.pi * (PUSH - 0.02) / period)
     window = PUSH >= 0.02 - 1e-12
     f = force[window]
-    # sample by sample the force goes up and down, and the rising case even ends below where the window began
-    assert np.mean(np.diff(f) < 0) > 0.4 and f[-1] < f[0]
+    # sample by sample the force goes up and down
+    assert np.mean(np.diff(f) < 0) > 0.25
     half = PUSH[window] > 0.03
-    assert bool(f[half].mean() > f[~half].mean()) is jam  # the means carry the trend
-    assert jammed(PUSH, STUCK, force) is jam
+    assert (f[half].mean() > f[~half].mean()) == (trend > 0)  # the means carry the trend ...
+    assert jammed(PUSH, STUCK, force) is jam  # ... but only a rise beyond the ringing is a jam
