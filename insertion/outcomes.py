@@ -112,13 +112,12 @@ def jammed(depth, tip_arc, push_force, window=JAM_PUSH, progress=JAM_PROGRESS):
     """Has the tip stopped advancing while the push force rises, at the last sample?
 
     The tip jams when, over the last ``window`` of push, it advanced less than ``progress`` along
-    the centerline while the push force rose: its mean over the second half of the window exceeds
-    that over the first half by more than the force's standard deviation over the window. Means,
-    because the drive reaction rings at the scope's axial frequencies; and a rise that stands out
-    of that ringing, because a thin scope that bows into a wide lumen stalls its tip under a
-    few newtons that merely fluctuate (a THF run at beta = 45 deg was stopped so) while a tip
-    held by the wall loads the scope steadily (an RSJ tip held at the junction: 7 to 34 N over
-    2 cm).
+    the centerline while the push force rose: the straight line fitted to the force against the
+    pushed depth over the window rises by more than twice the scatter of the force about that
+    line. The drive reaction rings at the scope's axial frequencies, and a thin scope that bows
+    into a wide lumen stalls its tip under a few newtons that only fluctuate (a THF run at
+    beta = 45 deg was stopped so by a comparison of means), while a tip held by the wall loads the
+    scope steadily (an RSJ tip held at the junction: 7 to 34 N over 2 cm).
 
     Parameters
     ----------
@@ -136,7 +135,9 @@ def jammed(depth, tip_arc, push_force, window=JAM_PUSH, progress=JAM_PROGRESS):
     arc = np.asarray(tip_arc, dtype=float)
     if arc[-1] - arc[start] >= progress:
         return False
+    zw = z[start:]
     f = np.asarray(push_force, dtype=float)[start:]
-    mid = z[start] + 0.5 * (z[-1] - z[start])
-    first, second = f[z[start:] <= mid], f[z[start:] > mid]
-    return bool(first.size and second.size and second.mean() - first.mean() > f.std())
+    slope, intercept = np.polyfit(zw, f, 1)
+    rise = slope * (zw[-1] - zw[0])
+    scatter = np.std(f - (slope * zw + intercept))
+    return bool(rise > 0.0 and rise > 2.0 * scatter)

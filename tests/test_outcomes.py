@@ -121,6 +121,7 @@ def test_constant_depth_is_no_jam():
 
 @pytest.mark.parametrize("trend, jam", [(1000.0, True), (50.0, False), (-50.0, False)])
 def test_ringing_force_is_judged_by_a_rise_that_stands_out_of_it(trend, jam):
+    # (a straight-line fit of force against depth over the window; its rise against the scatter)
     """The drive reaction rings: 5 N at a period of 2/21 cm of push (10.5 periods in the window), on a
     trend of 1000 N/m (20 N over the window: a tip held by the wall) or +-50 N/m (+-0.5 N between the
     half-window means, within the ringing: a scope bowing into a wide lumen)."""
@@ -132,4 +133,4 @@ def test_ringing_force_is_judged_by_a_rise_that_stands_out_of_it(trend, jam):
     assert np.mean(np.diff(f) < 0) > 0.25
     half = PUSH[window] > 0.03
     assert (f[half].mean() > f[~half].mean()) == (trend > 0)  # the means carry the trend ...
-    assert jammed(PUSH, STUCK, force) is jam  # ... but only a rise beyond the ringing is a jam
+    assert jammed(PUSH, STUCK, force) is jam  # ... but only a rise beyond twice the ringing is a jam
