@@ -15,8 +15,8 @@ adds what an insertion run needs from a model (**assumptions** where marked):
 - THF / fixed THF: the scope enters the transverse colon directly;
 - RSF, THF: straightening ends where the mobile part ends (``straighten_depth``); while
   straightening, each mobile node may only move along the straight piece it belongs to
-  (``mobile_axes``): the sigmoid, or each transverse arm, the V-bottom fillet going with the
-  first. After it the push goes on until the scope's available length is used or the tip
+  (``mobile_axes``): the sigmoid, or each transverse arm, each with its half of the V-bottom
+  fillet. After it the push goes on until the scope's available length is used or the tip
   reaches the model's far end (``end_depth`` = the centerline's length).
 
 :func:`colon_geometry` returns a :class:`ColonGeometry`. A straight tube (``"straight"``) is
@@ -74,28 +74,31 @@ class ColonGeometry:
 
 
 def _mobile_axes(centerline, mesh, name):
-    """(direction (3,), node indices) per straight piece called ``name``: its mobile nodes and those
-    of the mobile arcs (fillets) next to it, which may only move along the straight. An arc joins
-    the straight before it in its run of mobile pieces, or the one after it if none precedes."""
+    """(direction (3,), node indices) per mobile straight piece called ``name``: its mobile nodes
+    and those of the mobile arcs (fillets) next to it, which may only move along the straight.
+
+    An arc between two such straights (the bottom of the THF V) is split at its middle, each half
+    going with its own straight; an arc next to one only goes with it whole; other arcs stay free.
+    (Giving the whole V-bottom fillet to the first arm held the nodes of its second half to a
+    direction across their own tube at beta = 45 deg: the scope then crushed them against the
+    constraint and two THF runs diverged.)
+    """
     pieces = centerline.pieces
-    groups, owner, waiting = [], {}, []
+    own = {i: [mesh.mobile & (mesh.piece == i)] for i, p in enumerate(pieces)
+           if isinstance(p, Straight) and p.tag == "mobile" and p.name == name}
     for i, piece in enumerate(pieces):
-        if piece.tag != "mobile":
-            waiting = []  # a fixed piece ends the run: arcs before it stay unconstrained
-            owner.pop("last", None)
+        if piece.tag != "mobile" or isinstance(piece, Straight):
             continue
-        if isinstance(piece, Straight) and piece.name == name:
-            groups.append((centerline.tangent(centerline.s_start[i]), [i, *waiting]))
-            waiting = []
-            owner["last"] = len(groups) - 1
-        elif isinstance(piece, Straight):
-            waiting = []
-            owner.pop("last", None)
-        elif "last" in owner and i > 0 and pieces[i - 1].tag == "mobile":
-            groups[owner["last"]][1].append(i)
-        else:
-            waiting.append(i)
-    axes = [(d, np.flatnonzero(mesh.mobile & np.isin(mesh.piece, idx))) for d, idx in groups]
+        nodes = mesh.mobile & (mesh.piece == i)
+        before, after = i - 1 in own, i + 1 in own
+        if before and after:
+            first = nodes & (mesh.s < 0.5 * (centerline.s_start[i] + centerline.s_end[i]))
+            own[i - 1].append(first)
+            own[i + 1].append(nodes & ~first)
+        elif before or after:
+            own[i - 1 if before else i + 1].append(nodes)
+    axes = [(centerline.tangent(centerline.s_start[i]), np.flatnonzero(np.logical_or.reduce(masks)))
+            for i, masks in own.items()]
     return [(d, nodes) for d, nodes in axes if nodes.size]
 
 
