@@ -32,7 +32,7 @@ def _mesh(text):
 
 def _add_calibrate(sub):
     p = sub.add_parser("calibrate", help="identify hyperelastic parameters from tensile test curves",
-                       description="Fit a hyperelastic law to strip tensile curves (SPEC.md 1): Latin-hypercube "
+                       description="Fit a hyperelastic law to strip tensile curves (docs/model.md): Latin-hypercube "
                                    "sensitivity study -> CMA-ES -> Nelder-Mead on a scikit-fem model of the "
                                    "clamped specimen. Writes material.json (read by the insertion solver), "
                                    "CSV tables and figures.")
@@ -287,7 +287,7 @@ def cmd_demo(args):
 
 def _add_insert(sub):
     p = sub.add_parser("insert", help="simulate a colonoscope insertion (explicit dynamics)",
-                       description="Push a colonoscope through a colon model (SPEC.md 2) and record the colon "
+                       description="Push a colonoscope through a colon model (docs/model.md) and record the colon "
                                    "deformation, contact and push forces, tip motion and energies. Writes "
                                    "timeseries.csv, summary.json and insertion.png per scope, a comparison table "
                                    "and figure, and optional VTU files for ParaView.")

@@ -1,4 +1,4 @@
-"""Generate the bundled SYNTHETIC tensile data set (SPEC.md 1.6). Rerun: python data/generate_synthetic.py
+"""Generate the bundled SYNTHETIC tensile data set (docs/model.md). Rerun: python data/generate_synthetic.py
 
 No public colon tensile data set exists, so the bundled curves are made here:
 - 8 specimens whose Mooney-Rivlin parameters scatter (log-normal, 15 % sd) around the source's

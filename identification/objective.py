@@ -1,4 +1,4 @@
-"""The calibration objective of SPEC.md 1.4.
+"""The calibration objective of docs/model.md.
 
     e1 = sum_i (F_exp_i - F_sim_i)^2      (N^2)
 

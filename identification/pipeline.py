@@ -1,4 +1,4 @@
-"""The identification pipeline of SPEC.md 1.5: sensitivity study -> CMA-ES -> Nelder-Mead.
+"""The identification pipeline of docs/model.md: sensitivity study -> CMA-ES -> Nelder-Mead.
 
 1. Sensitivity study: a Latin hypercube over the parameter bounds, every design evaluated with
    the force model and ranked by the objective e1; each parameter's sensitivity is reported as
@@ -31,11 +31,11 @@ from identification.testdata import TensileCurve
 from identification.uniaxial import HomogeneousStripModel
 from identification.uncertainty import FitUncertainty, fit_uncertainty
 
-# SPEC.md 1.4: bounds and initial guess for the 3-parameter Mooney-Rivlin law, Pa.
+# docs/model.md: bounds and initial guess for the 3-parameter Mooney-Rivlin law, Pa.
 DEFAULT_BOUNDS = {"C10": (0.0, 0.06e6), "C01": (0.0, 0.06e6), "C11": (0.0, 2.5e6)}
 DEFAULT_INITIAL = {"C10": 0.03e6, "C01": 0.03e6, "C11": 1.25e6}
 # Bounds of the comparison laws (not in the source): wide enough to reach the tangent moduli of
-# SPEC.md 1.1 (0.36 MPa at 10 %, 2.5 MPa at 60 % strain); initial guess at their centre.
+# docs/model.md (0.36 MPa at 10 %, 2.5 MPa at 60 % strain); initial guess at their centre.
 LAW_BOUNDS = {
     "mooney_rivlin_3": DEFAULT_BOUNDS,
     # C10 up to the neo-Hookean's bound: a law that contains another must contain its box too,
@@ -47,7 +47,7 @@ LAW_BOUNDS = {
 
 
 def default_start(law_name):
-    """Bounds and initial guess (Pa) of a law: SPEC.md 1.4 for Mooney-Rivlin 3, centres otherwise."""
+    """Bounds and initial guess (Pa) of a law: docs/model.md for Mooney-Rivlin 3, centres otherwise."""
     bounds = LAW_BOUNDS[law_name]
     if law_name == "mooney_rivlin_3":
         return bounds, DEFAULT_INITIAL
@@ -179,14 +179,14 @@ def sensitivity_measures(designs: pd.DataFrame, names) -> pd.DataFrame:
 
 def calibrate(objective: CurveObjective, bounds=None, initial=None, budget: Budget | None = None,
               seed=1, progress=None) -> CalibrationResult:
-    """Identify the law parameters that minimise ``objective`` (SPEC.md 1.5).
+    """Identify the law parameters that minimise ``objective`` (docs/model.md).
 
     Parameters
     ----------
     objective : CurveObjective
     bounds, initial : dict, optional
         Parameter bounds and initial guess in Pa; default :func:`default_start` of the model's law
-        (SPEC.md 1.4 for the 3-parameter Mooney-Rivlin).
+        (docs/model.md for the 3-parameter Mooney-Rivlin).
     budget : Budget, optional
     seed : int
         Seeds the Latin hypercube and CMA-ES: the same seed gives the same result.
@@ -271,7 +271,7 @@ def compare_models(objective: CurveObjective, params, lower, upper) -> dict:
     small-strain modulus each model identifies from the same curve.
 
     Whichever model was fitted, the other is evaluated at the identified parameters on the same
-    displacements (how much the homogeneous assumption misreads the clamped test, SPEC.md 1.3),
+    displacements (how much the homogeneous assumption misreads the clamped test, docs/model.md),
     then refitted locally from them (:func:`refit_locally`): the two mu0 differ by the
     model-form share of the uncertainty, which the noise-only sd of the fit does not contain.
     """

@@ -24,7 +24,7 @@ from identification.report import MATERIAL_FORMAT, write_calibration
 
 def calibrate_curve(curve, law="mooney_rivlin_3", analytic=False, budget=None, seed=1, bounds=None,
                     initial=None, n_points=20, progress=None, **mesh) -> CalibrationResult:
-    """Run the whole pipeline of SPEC.md 1.5 on one test curve."""
+    """Run the whole pipeline of docs/model.md on one test curve."""
     objective = CurveObjective(curve, make_model(curve, law, analytic, **mesh), n_points=n_points)
     return calibrate(objective, bounds, initial, budget, seed, progress)
 

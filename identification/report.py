@@ -4,7 +4,7 @@ Layout of one calibration folder::
 
     material.json       parameters, uncertainty, correlation, fit quality (colonsim-material/1)
     history.csv         every objective evaluation (stage, parameters in Pa, e1 in N^2, seconds)
-    sensitivity.csv     Spearman sensitivity of each parameter (SPEC.md 1.5 step 1)
+    sensitivity.csv     Spearman sensitivity of each parameter (docs/model.md, "The fit", step 1)
     top10_designs.csv   the 10 best designs of the sensitivity study (CMA-ES start population)
     fit.csv             experimental and fitted force at the simulation displacements (mm, N)
     sensitivity.png, objective.png, fit.png

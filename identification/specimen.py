@@ -1,4 +1,4 @@
-"""Finite-element model of the clamped tensile specimen (SPEC.md 1.3), built on scikit-fem.
+"""Finite-element model of the clamped tensile specimen (docs/model.md), built on scikit-fem.
 
 The strip is a thin incompressible sheet in plane stress (:mod:`identification.membrane`). By
 symmetry only a quarter is meshed: ``0 <= X <= L/2`` (X = 0 is the mid-length plane, which does

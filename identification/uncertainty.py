@@ -5,7 +5,7 @@ covariance at the optimum is
 
     Sigma = s^2 (J^T J)^-1,  J = dF_sim / dtheta,  s^2 = |r|^2 / (n - p),
 
-which also absorbs systematic misfit into s^2. SPEC.md 1.5 warns that uniaxial data pin
+which also absorbs systematic misfit into s^2. docs/model.md warns that uniaxial data pin
 C10 + C01 and C11 but barely the C10/C01 split: this shows as a correlation near -1 and a
 large condition number of J^T J, and is reported rather than hidden.
 """

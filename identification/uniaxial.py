@@ -17,7 +17,7 @@ def nominal_stress(stretch, law: Law, params):
     """First Piola-Kirchhoff (nominal) stress of homogeneous uniaxial tension, Pa.
 
     P = 2 (l - l^-2) (W1 + W2 / l); for the three-parameter Mooney-Rivlin law this is
-    SPEC.md 1.2's P = 2 (l - l^-2) [C10 + C11 (I2-3) + (C01 + C11 (I1-3)) / l].
+    docs/model.md's P = 2 (l - l^-2) [C10 + C11 (I2-3) + (C01 + C11 (I1-3)) / l].
     """
     l = np.asarray(stretch, dtype=float)
     I1, I2 = uniaxial_invariants(l)

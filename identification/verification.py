@@ -23,9 +23,9 @@ from identification.specimen import ClampedStripModel
 from identification.testdata import TensileCurve, read_manifest
 from identification.uniaxial import homogeneous_force, nominal_stress
 
-# SPEC.md 1.5: the source's identified parameters (C10, C01, C11), Pa.
+# docs/model.md: the source's identified parameters (C10, C01, C11), Pa.
 REFERENCE = np.array([652.01, 42835.25, 219120.3])
-# SPEC.md 1.1: free length and width of the source's strips, m; thickness 2 mm (an assumption).
+# docs/model.md: free length and width of the source's strips, m; thickness 2 mm (an assumption).
 STRIP = (0.1, 0.025, 0.002)
 DISPLACEMENTS = np.linspace(3e-3, 60e-3, 6)  # up to 60 % strain, the end of the test
 DATA = Path(__file__).resolve().parents[1] / "data" / "tensile"
@@ -56,7 +56,7 @@ def specimen_against_closed_form(grips, params=REFERENCE, displacements=DISPLACE
 
 
 def membrane_uniaxial_stress(stretches, params=REFERENCE, law="mooney_rivlin_3"):
-    """The plane-stress membrane law at F = diag(l, l^-1/2) against SPEC.md 1.2's closed form.
+    """The plane-stress membrane law at F = diag(l, l^-1/2) against docs/model.md's closed form.
 
     Returns (axial nominal stress of the membrane, closed form, lateral stress of the membrane), Pa.
     """
@@ -116,7 +116,7 @@ class SpecimenRecovery:
 
 
 def specimen_recovery(specimen="specimen_01", budget: Budget | None = None, seed=1, data=DATA) -> SpecimenRecovery:
-    """Calibrate the bundled ``specimen`` with the FE pipeline (SPEC.md 1.5) at ``budget``."""
+    """Calibrate the bundled ``specimen`` with the FE pipeline (docs/model.md) at ``budget``."""
     truth_doc = ground_truth(data)
     curves = {c.name: c for c in read_manifest(Path(data) / "manifest.csv")}
     curve = curves[specimen]

@@ -1,6 +1,6 @@
 """Patient-level queries: named presets for sex, age and region, next to raw parameters.
 
-The mapping is the project's reading of the source (SPEC.md 2.1, 3), not a clinical law; every
+The mapping is the project's reading of the source (docs/model.md, "Patients"), not a clinical law; every
 value can be overridden by a JSON file or by giving the raw parameter:
 
 - sex -> the angle of the mobile part: alpha of the sigmoid (RSF) and beta of the transverse colon
@@ -12,7 +12,7 @@ value can be overridden by a JSON file or by giving the raw parameter:
   also ties age to the fixed sigmoid angulation; the segments here keep that angulation fixed.
 - region -> colon inner diameter, from Watters et al. 1985 for the RSJ: European 23 mm, African
   36 mm. The source gives no regional diameters for the other segments: there the preset leaves
-  the diameter to the model (its fixed value, 36 mm by SPEC.md's assumption).
+  the diameter to the model (its fixed value, 36 mm by the model's assumption).
 """
 
 from __future__ import annotations

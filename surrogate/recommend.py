@@ -30,7 +30,7 @@ from surrogate.validation import Z95
 
 
 def default_scopes(domain):
-    """The named scopes the sweep ran (UTC, PDC, SDC or its own), else the three of SPEC.md 2.2."""
+    """The named scopes the sweep ran (UTC, PDC, SDC or its own), else the three of docs/model.md."""
     named = {k: v for k, v in domain.scopes.items() if k in NAMED_SCOPES_MM}
     table = named or domain.scopes or NAMED_SCOPES_MM
     return sorted(table, key=lambda name: table[name])  # thinnest first

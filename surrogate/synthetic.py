@@ -1,7 +1,7 @@
 """SYNTHETIC sweep tables for testing the regression machinery - not physics.
 
 The outputs are a known smooth function of the inputs plus small Gaussian noise, loosely scaled
-to the source's RSJ numbers (SPEC.md 2.5) so that tables look like real ones: deformation grows
+to the source's RSJ numbers (docs/model.md) so that tables look like real ones: deformation grows
 with the scope diameter, falls with the colon diameter, grows with the angle and the friction.
 Tests check that the surrogate recovers the function within its stated accuracy; the benchmark
 times fits on such tables. Nothing here says anything about colons.

@@ -1,4 +1,4 @@
-"""The identification pipeline (SPEC.md 1.5): recovery, reproducibility, records, result files."""
+"""The identification pipeline (docs/model.md): recovery, reproducibility, records, result files."""
 
 import json
 from pathlib import Path
@@ -46,7 +46,7 @@ def test_recovers_a_bundled_specimen_within_the_noise(recovery):
     np.testing.assert_array_equal(truth, [TRUTH["specimens"]["specimen_01"]["parameters_Pa"][n] for n in NAMES])
     assert r.fit["rms_N"] <= 1.5 * recovery.noise_sd
     assert recovery.truth_in_region, (r.uncertainty.mahalanobis2(truth), r.uncertainty.region_threshold())
-    # The split C10/C01 is barely identifiable (SPEC.md 1.5) but their sum is: mu0 within 3 sd.
+    # The split C10/C01 is barely identifiable (docs/model.md) but their sum is: mu0 within 3 sd.
     mu0, sd, true_mu0 = recovery.mu0
     assert abs(mu0 - true_mu0) < 3 * sd
     assert r.uncertainty.correlation[0, 1] < -0.9

@@ -121,7 +121,7 @@ def test_rsj_ordering_needs_point_a_and_c_above_a():
 
 
 def test_the_source_numbers_reproduce_the_source_claims_at_mu_0():
-    """SPEC.md 2.5's own table satisfies the claims it supports (mu = 0 only)."""
+    """docs/model.md's own table satisfies the claims it supports (mu = 0 only)."""
     src = source_rsj_table()
     assert sc_deform_less_rsj(src, frictions=(0.0,)).verdict == REPRODUCED
     assert reduction_larger_at_small_diameter(src, frictions=(0.0,)).verdict == REPRODUCED

@@ -7,7 +7,7 @@ from colonsim.errors import ColonsimError
 from identification.laws import get_law
 from identification.uniaxial import homogeneous_force, nominal_stress, tangent_modulus, uniaxial_invariants
 
-REFERENCE = (652.01, 42835.25, 219120.3)  # SPEC.md 1.5, Pa
+REFERENCE = (652.01, 42835.25, 219120.3)  # docs/model.md, Pa
 
 
 def test_mooney_rivlin_3_hand_values():
@@ -42,7 +42,7 @@ def test_uniaxial_invariants_incompressible():
 
 
 def test_nominal_stress_hand_value():
-    # SPEC.md 1.2 at l = 1.5 with the reference parameters:
+    # docs/model.md at l = 1.5 with the reference parameters:
     # I1 = 3.583333, I2 = 3.444444; P = 2 (1.5 - 1/2.25) [C10 + C11 (I2-3) + (C01 + C11 (I1-3)) / 1.5]
     #   = 2.111111 * [652.01 + 97386.8 + (42835.25 + 127820.2) / 1.5] = 2.111111 * 211809.2 = 447152.5 Pa
     lam = 1.5
@@ -75,7 +75,7 @@ def test_homogeneous_force_scales_with_section():
 
 
 def test_reference_parameters_reproduce_the_observed_moduli():
-    """SPEC.md 1.1 reports about 0.36 MPa at 10 % and about 2.5 MPa at 60 % strain; the source's
+    """docs/model.md reports about 0.36 MPa at 10 % and about 2.5 MPa at 60 % strain; the source's
     parameters give 0.35 and 2.19 MPa: within 15 % (the source's 'about', read off a plot)."""
     L = get_law("mooney_rivlin_3")
     assert tangent_modulus(1.1, L, REFERENCE) == pytest.approx(0.36e6, rel=0.15)

@@ -15,7 +15,7 @@ from insertion.rod import Rod
 from insertion.verification import (SCOPE_D, SCOPE_E, SCOPE_RHO, axial_wave, cantilever, cantilever_tip_deflection,
                                     compressed_min_eigenvalue, euler_buckling_load, euler_load)
 
-E, RHO, D = SCOPE_E, SCOPE_RHO, SCOPE_D  # the standard scope (SPEC 2.2)
+E, RHO, D = SCOPE_E, SCOPE_RHO, SCOPE_D  # the standard scope (catalogue diameter)
 
 
 def test_cantilever_tip_load_matches_beam_theory():

@@ -1,4 +1,4 @@
-"""Colonoscope definitions (SPEC.md 2.2)."""
+"""Colonoscope definitions (docs/model.md)."""
 
 import math
 

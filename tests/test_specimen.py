@@ -1,4 +1,4 @@
-"""The scikit-fem specimen model (SPEC.md 1.3): tangent, grips, mesh convergence."""
+"""The scikit-fem specimen model (docs/model.md): tangent, grips, mesh convergence."""
 
 import numpy as np
 import pytest
@@ -42,7 +42,7 @@ def test_sliding_grips_equal_the_closed_form():
 
 
 def test_clamped_grips_are_stiffer_by_a_few_percent():
-    """SPEC.md 1.3: the clamp blocks lateral contraction near the grips, 2-3 % for this geometry."""
+    """docs/model.md: the clamp blocks lateral contraction near the grips, 2-3 % for this geometry."""
     excess = specimen_against_closed_form("clamped").relative_difference
     assert np.all(excess > 0.01) and np.all(excess < 0.05), excess
 
