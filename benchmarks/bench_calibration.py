@@ -15,16 +15,16 @@ Targets of issue 2 on the 2-core machine: one evaluation <= 0.25 s, the pipeline
 import argparse
 import statistics
 import time
-from pathlib import Path
 
 import numpy as np
 
-from identification.objective import CurveObjective, make_model
-from identification.pipeline import Budget, calibrate
-from identification.specimen import ClampedStripModel
-from identification.testdata import mean_curve, read_manifest
+from colonsim.data import TENSILE_DIR
+from colonsim.identification.objective import CurveObjective, make_model
+from colonsim.identification.pipeline import Budget, calibrate
+from colonsim.identification.specimen import ClampedStripModel
+from colonsim.identification.testdata import mean_curve, read_manifest
 
-DATA = Path(__file__).resolve().parents[1] / "data" / "tensile"
+DATA = TENSILE_DIR
 REFERENCE = np.array([652.01, 42835.25, 219120.3])
 MESHES = [(4, 1), (6, 2), (8, 3), (12, 4), (16, 6), (24, 8), (32, 12), (48, 16)]
 
@@ -45,7 +45,7 @@ def naive_assembly_time(model, params, repeat=5):
     and contracted by einsum), on the same mesh and state, full dof set."""
     from skfem import Basis, BilinearForm, ElementTriP2, ElementVector, LinearForm, asm
 
-    from identification.membrane import membrane_stress
+    from colonsim.identification.membrane import membrane_stress
 
     basis = Basis(model.mesh, ElementVector(ElementTriP2()), intorder=4)
     u = basis.zeros()

@@ -13,9 +13,9 @@ import time
 
 import numba
 
-from insertion.reference import SOURCE_RSJ_CM
-from insertion.scenario import InsertionCase, run_insertion
-from insertion.scopes import MESHED_DIAMETERS
+from colonsim.insertion.study.reference import SOURCE_RSJ_CM
+from colonsim.insertion.case.scenario import InsertionCase, run_insertion
+from colonsim.insertion.anatomy.scopes import MESHED_DIAMETERS
 
 TIMED = ("sdc", 36.0)
 

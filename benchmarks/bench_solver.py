@@ -16,18 +16,17 @@ steps each (one model, continuing in time) and reports the median.
 """
 
 import argparse
-import math
 import time
 
 import numba
 import numpy as np
 
-from insertion.contact import RodShellContact
-from insertion.material import REFERENCE_MATERIAL_PATH, load_material
-from insertion.rod import Rod
-from insertion.sheet_mesh import straight_tube
-from insertion.shell import Shell
-from insertion.solver import ExplicitSolver, FixedNodes, LineConstraint, NodalLoad, PrescribedVelocity
+from colonsim.insertion.engine.contact import RodShellContact
+from colonsim.insertion.engine.material import REFERENCE_MATERIAL_PATH, load_material
+from colonsim.insertion.engine.rod import Rod
+from colonsim.insertion.engine.sheet_mesh import straight_tube
+from colonsim.insertion.engine.shell import Shell
+from colonsim.insertion.engine.solver import ExplicitSolver, FixedNodes, LineConstraint, NodalLoad, PrescribedVelocity
 
 LUMEN = 0.036
 WALL = 2e-3

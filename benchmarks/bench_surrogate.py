@@ -1,7 +1,7 @@
 """Speed of the surrogate against the issue's targets.
 
 On a SYNTHETIC table of ``--runs`` runs (default 500) of one segment with five varying inputs
-(scope diameter, colon diameter, angle, friction, wall thickness; surrogate.synthetic plus a wall
+(scope diameter, colon diameter, angle, friction, wall thickness; colonsim.surrogate.synthetic plus a wall
 term), it times:
 
 - the fit of every default output (7 GPs, closed-form leave-one-out CV included)  target < 30 s
@@ -21,9 +21,9 @@ from pathlib import Path
 
 import numpy as np
 
-from surrogate.model import SweepSurrogate
-from surrogate.store import load_surrogate, save_surrogate
-from surrogate.synthetic import synthetic_outputs, synthetic_sweep
+from colonsim.surrogate.model import SweepSurrogate
+from colonsim.surrogate.store import load_surrogate, save_surrogate
+from colonsim.surrogate.synthetic import synthetic_outputs, synthetic_sweep
 
 
 def five_input_table(n_runs, seed=0):

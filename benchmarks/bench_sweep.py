@@ -16,8 +16,8 @@ from pathlib import Path
 
 os.environ.setdefault("NUMBA_NUM_THREADS", "1")  # this process only waits and writes files
 
-from insertion.sweep import run_sweep  # noqa: E402
-from insertion.sweep_spec import PRESETS, load_sweep  # noqa: E402
+from colonsim.insertion.study.sweep import run_sweep  # noqa: E402
+from colonsim.insertion.study.sweep_spec import PRESETS, load_sweep  # noqa: E402
 
 
 def spread(cases, n):

@@ -15,7 +15,7 @@ from matplotlib.figure import Figure
 
 from colonsim.files import save_figure
 from colonsim.markdown import num
-from insertion import verification as iv
+from colonsim.insertion.study import verification as iv
 
 
 # --- verification ------------------------------------------------------------------------------
@@ -161,7 +161,7 @@ def verify_energy_contact():
 
 
 def verify_specimen(full):
-    from identification import verification as idv
+    from colonsim.identification import verification as idv
 
     rows = []
     axial, closed, lateral = idv.membrane_uniaxial_stress(np.linspace(1.05, 1.6, 8))
@@ -196,9 +196,9 @@ def verify_specimen(full):
 # --- calibration recovery -------------------------------------------------------------------------
 
 def calibration_recovery(full, out):
-    from identification.pipeline import Budget
-    from identification.report import fit_figure
-    from identification.verification import specimen_recovery
+    from colonsim.identification.pipeline import Budget
+    from colonsim.identification.report import fit_figure
+    from colonsim.identification.verification import specimen_recovery
 
     budget = Budget() if full else Budget.quick()
     t0 = time.perf_counter()

@@ -8,11 +8,11 @@ from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 
 from colonsim.files import save_figure
-from insertion.reference import SOURCE_RSJ_CM
-from insertion.results import read_final_shape
+from colonsim.insertion.study.reference import SOURCE_RSJ_CM
+from colonsim.insertion.case.results import read_final_shape
 
-from benchmarks.validation_sections import RSJ_DIAMETERS, case_geometry
-from benchmarks.validation_sweeps import SCOPES, role
+from validation_sections import RSJ_DIAMETERS, case_geometry
+from validation_sweeps import SCOPES, role
 
 COLOURS = {"utc": "tab:blue", "pdc": "tab:orange", "sdc": "tab:red", None: "tab:gray"}
 

@@ -32,20 +32,18 @@ from pathlib import Path
 import numpy as np
 
 ROOT = Path(__file__).resolve().parents[1]
-if str(ROOT) not in sys.path:  # run as a script from a checkout: import this tree's packages
-    sys.path.insert(0, str(ROOT))
 
-from colonsim.errors import ColonsimError  # noqa: E402
-from colonsim.files import write_json  # noqa: E402
-from colonsim.provenance import code_version  # noqa: E402
-from insertion.claims import evaluate_claims  # noqa: E402
+from colonsim.errors import ColonsimError
+from colonsim.files import write_json
+from colonsim.provenance import code_version
+from colonsim.insertion.study.claims import evaluate_claims
 
-from benchmarks import validation_checks as checks  # noqa: E402
-from benchmarks import validation_figures as figures  # noqa: E402
-from benchmarks import validation_sections as sections  # noqa: E402
-from benchmarks.validation_markdown import write_markdown  # noqa: E402
-from benchmarks.validation_readings import add_readings  # noqa: E402
-from benchmarks.validation_sweeps import paired, read_sweep  # noqa: E402
+import validation_checks as checks
+import validation_figures as figures
+import validation_sections as sections
+from validation_markdown import write_markdown
+from validation_readings import add_readings
+from validation_sweeps import paired, read_sweep
 
 SYMBOL = {"rsf": "alpha", "thf": "beta"}
 

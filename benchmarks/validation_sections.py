@@ -12,12 +12,12 @@ from functools import lru_cache
 import numpy as np
 import pandas as pd
 
-from insertion.claims import NO_DEFORMATION_CM, advantage
-from insertion.colon_segments import colon_geometry
-from insertion.reference import SOURCE_MESHES, SOURCE_RSJ_CM, SOURCE_RUN_MINUTES
-from insertion.scenario import InsertionCase
+from colonsim.insertion.study.claims import NO_DEFORMATION_CM, advantage
+from colonsim.insertion.anatomy.colon_segments import colon_geometry
+from colonsim.insertion.study.reference import SOURCE_MESHES, SOURCE_RSJ_CM, SOURCE_RUN_MINUTES
+from colonsim.insertion.case.scenario import InsertionCase
 
-from benchmarks.validation_sweeps import SCOPES, find_case, paired, relative_change, role, scope_label
+from validation_sweeps import SCOPES, find_case, paired, relative_change, role, scope_label
 
 RSJ_DIAMETERS = (23.0, 36.0)
 # Wall nodes of the source's colon meshes, where it gives them.
@@ -49,7 +49,7 @@ def _ratio(a, b):
 
 
 def case_geometry(case, exit_length_mm=None):
-    """The colon of ``case`` as :func:`insertion.colon_segments.colon_geometry` builds it (SI)."""
+    """The colon of ``case`` as :func:`colonsim.insertion.anatomy.colon_segments.colon_geometry` builds it (SI)."""
     exit_mm = case.exit_length_mm if exit_length_mm is None else exit_length_mm
     return _geometry(case.segment, case.diameter_mm, case.angle_deg, case.element_size_mm, case.wall_thickness_mm,
                      exit_mm, case.flexure_angle_deg)

@@ -19,10 +19,10 @@ import numpy as np
 import pandas as pd
 
 from colonsim.errors import ColonsimError
-from insertion.scenario import InsertionCase
-from insertion.scopes import scope_role
-from insertion.sweep import TABLE, read_results
-from insertion.sweep_spec import load_sweep, parse_sweep
+from colonsim.insertion.case.scenario import InsertionCase
+from colonsim.insertion.anatomy.scopes import scope_role
+from colonsim.insertion.study.sweep import TABLE, read_results
+from colonsim.insertion.study.sweep_spec import load_sweep, parse_sweep
 
 SCOPES = ("utc", "pdc", "sdc")
 # the input a validation run changes -> the check it belongs to

@@ -12,12 +12,11 @@ import warnings
 from pathlib import Path
 
 from colonsim import cli_surrogate, cli_sweep
+from colonsim.data import BUNDLED_MANIFEST
 from colonsim.errors import ColonsimError, ColonsimWarning
 from colonsim.options import finite_float, output_folder, positive_int
-from insertion.run_budget import DEFAULT_MAX_STEPS
+from colonsim.insertion.case.run_budget import DEFAULT_MAX_STEPS
 
-REPO_DATA = Path(__file__).resolve().parents[1] / "data"
-BUNDLED_MANIFEST = REPO_DATA / "tensile" / "manifest.csv"
 
 
 def _mesh(text):
@@ -74,7 +73,7 @@ def _load_curves(args):
     lines, and geometry taken from a file's preamble is said."""
     import warnings
 
-    from identification.testdata import CurveWarning, read_curve, read_manifest
+    from colonsim.identification.testdata import CurveWarning, read_curve, read_manifest
 
     units = {"displacement_unit": args.displacement_unit, "force_unit": args.force_unit}
     if args.curve and args.manifest:
@@ -127,9 +126,9 @@ class _Progress:
 
 
 def _format_result(r) -> str:
-    from identification.diagnostics import split_unidentified
-    from identification.report import small_strain
-    from insertion.material import solver_law_gap
+    from colonsim.identification.diagnostics import split_unidentified
+    from colonsim.identification.report import small_strain
+    from colonsim.insertion.engine.material import solver_law_gap
 
     unc, ci = r.uncertainty, r.uncertainty.interval()
     lines = [f"{r.curve.name}: {r.model['model']}, law {r.model['law']}"]
@@ -170,7 +169,7 @@ def _format_result(r) -> str:
 
 
 def _print_warnings(results):
-    from identification.diagnostics import misfit_warning
+    from colonsim.identification.diagnostics import misfit_warning
 
     for r in results:
         warning = misfit_warning(r)
@@ -181,11 +180,11 @@ def _print_warnings(results):
 def run_calibration(args, out: Path) -> list:
     """Load the curves named by ``args``, calibrate, write results into ``out``; return the results."""
     from colonsim.files import check_output_folder
-    from identification.laws import get_law
-    from identification.pipeline import Budget
-    from identification.population import calibrate_curve, calibrate_specimens, population_summary, population_table, write_population
-    from identification.report import write_calibration
-    from identification.testdata import mean_curve
+    from colonsim.identification.laws import get_law
+    from colonsim.identification.pipeline import Budget
+    from colonsim.identification.population import calibrate_curve, calibrate_specimens, population_summary, population_table, write_population
+    from colonsim.identification.report import write_calibration
+    from colonsim.identification.testdata import mean_curve
 
     check_output_folder(out)
     if args.compare_laws and args.law is not None:
@@ -247,9 +246,9 @@ def _compare_laws(curve, options, per_eval, show, out: Path) -> list:
     """``calibrate --compare-laws``: every law the solver runs on ``curve``, BIC chooses."""
     import pandas as pd
 
-    from identification.law_comparison import compare_laws, write_law_comparison
-    from identification.population import calibrate_curve
-    from insertion.material import SOLVER_LAWS
+    from colonsim.identification.law_comparison import compare_laws, write_law_comparison
+    from colonsim.identification.population import calibrate_curve
+    from colonsim.insertion.engine.material import SOLVER_LAWS
 
     bar = _Progress(per_eval * len(SOLVER_LAWS), "eval", show)
 
@@ -319,14 +318,14 @@ def _add_insert(sub):
 def run_insertions(cases, out: Path, vtu=False, snapshot_every=0.02, show=True, max_steps=DEFAULT_MAX_STEPS):
     """Run each case, write its folder under ``out`` and a comparison; return the results.
 
-    Every case is checked first, its run time estimated included (:mod:`insertion.run_budget`):
+    Every case is checked first, its run time estimated included (:mod:`colonsim.insertion.case.run_budget`):
     a case needing more than ``max_steps`` time steps is refused before any run starts."""
     from tqdm import tqdm
 
     from colonsim.files import save_figure, write_csv
-    from insertion.results import comparison_table, insertion_figure, write_insertion
-    from insertion.run_budget import check_run_budget
-    from insertion.scenario import run_insertion
+    from colonsim.insertion.case.results import comparison_table, insertion_figure, write_insertion
+    from colonsim.insertion.case.run_budget import check_run_budget
+    from colonsim.insertion.case.scenario import run_insertion
 
     budgets = [check_run_budget(case, max_steps) for case in cases]
     results = []
@@ -369,7 +368,7 @@ def run_insertions(cases, out: Path, vtu=False, snapshot_every=0.02, show=True, 
 def cmd_insert(args):
     import numba
 
-    from insertion.scenario import InsertionCase
+    from colonsim.insertion.case.scenario import InsertionCase
 
     if args.threads is not None:
         if not 1 <= args.threads <= numba.config.NUMBA_NUM_THREADS:
@@ -382,7 +381,7 @@ def cmd_insert(args):
                            element_size_mm=args.element_size, material=args.material,
                            exit_length_mm=args.exit_length) for scope in args.scope]
     if args.material is not None:
-        from insertion.material import load_material
+        from colonsim.insertion.engine.material import load_material
 
         load_material(args.material)
     run_insertions(cases, args.out, vtu=args.vtu, snapshot_every=args.snapshot_every, show=not args.no_progress,

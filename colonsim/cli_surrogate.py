@@ -114,7 +114,7 @@ def add_parsers(sub):
 
 def _model_path(text):
     """A model path whose .json and .npz files can both be written."""
-    from surrogate.store import model_paths
+    from colonsim.surrogate.store import model_paths
 
     file_type = output_file()
     for path in model_paths(text):
@@ -123,9 +123,9 @@ def _model_path(text):
 
 
 def cmd_fit(args):
-    from surrogate.model import SweepSurrogate
-    from surrogate.store import save_surrogate
-    from surrogate.table import TARGETS, read_results
+    from colonsim.surrogate.model import SweepSurrogate
+    from colonsim.surrogate.store import save_surrogate
+    from colonsim.surrogate.table import TARGETS, read_results
 
     if args.restarts < 0 or args.min_runs < 2 or args.threads < 1:
         raise ColonsimError("--restarts must be >= 0, --min-runs >= 2 and --threads >= 1")
@@ -139,7 +139,7 @@ def cmd_fit(args):
 
 
 def cmd_info(args):
-    from surrogate.store import load_surrogate, model_paths
+    from colonsim.surrogate.store import load_surrogate, model_paths
 
     model = load_surrogate(args.model)
     if args.json:
@@ -153,7 +153,7 @@ def _raw(args):
 
 
 def _presets(args):
-    from surrogate.patients import PatientPresets
+    from colonsim.surrogate.patients import PatientPresets
 
     return PatientPresets.from_json(args.presets) if args.presets else PatientPresets()
 
@@ -168,7 +168,7 @@ def _segment(args, model):
 
 def _patient_query(model, segment, args, presets):
     """Model inputs from presets, then raw options on top."""
-    from surrogate.patients import patient_inputs
+    from colonsim.surrogate.patients import patient_inputs
 
     return {**patient_inputs(segment, args.sex, args.age, args.region, presets), **_raw(args)}
 
@@ -178,8 +178,8 @@ def _query_frame(args, model):
     import numpy as np
     import pandas as pd
 
-    from surrogate.patients import patient_inputs
-    from surrogate.recommend import default_scopes
+    from colonsim.surrogate.patients import patient_inputs
+    from colonsim.surrogate.recommend import default_scopes
 
     presets = _presets(args)
     if args.csv:
@@ -227,7 +227,7 @@ def _records(frame):
 
 
 def _format_predictions(out, targets):
-    from surrogate.table import INPUTS, target_unit
+    from colonsim.surrogate.table import INPUTS, target_unit
 
     lines = []
     for _, row in out.iterrows():
@@ -245,7 +245,7 @@ def _format_predictions(out, targets):
 
 def cmd_predict(args):
     from colonsim.files import write_csv, write_json
-    from surrogate.store import load_surrogate
+    from colonsim.surrogate.store import load_surrogate
 
     model = load_surrogate(args.model)
     frame = _query_frame(args, model)
@@ -276,9 +276,9 @@ def cmd_predict(args):
 
 def cmd_recommend(args):
     from colonsim.files import write_json
-    from surrogate.patients import describe_patient
-    from surrogate.recommend import format_recommendation, recommend
-    from surrogate.store import load_surrogate
+    from colonsim.surrogate.patients import describe_patient
+    from colonsim.surrogate.recommend import format_recommendation, recommend
+    from colonsim.surrogate.store import load_surrogate
 
     model = load_surrogate(args.model)
     segment = _segment(args, model)
@@ -299,8 +299,8 @@ def cmd_recommend(args):
 
 def cmd_plot(args):
     from colonsim.files import save_figure
-    from surrogate.plot import prediction_figure
-    from surrogate.store import load_surrogate
+    from colonsim.surrogate.plot import prediction_figure
+    from colonsim.surrogate.store import load_surrogate
 
     model = load_surrogate(args.model)
     segment = _segment(args, model)

@@ -8,7 +8,7 @@ from pathlib import Path
 from colonsim.errors import ColonsimError
 from colonsim.files import check_output_folder
 from colonsim.options import output_folder, positive_int
-from insertion.run_budget import DEFAULT_MAX_STEPS
+from colonsim.insertion.case.run_budget import DEFAULT_MAX_STEPS
 
 
 def available_cores() -> int:
@@ -45,9 +45,9 @@ def add_parser(sub):
 
 
 def cmd_sweep(args):
-    from insertion.run_budget import check_sweep_budget
-    from insertion.sweep import SweepStore, describe_cases, run_sweep
-    from insertion.sweep_spec import load_sweep
+    from colonsim.insertion.case.run_budget import check_sweep_budget
+    from colonsim.insertion.study.sweep import SweepStore, describe_cases, run_sweep
+    from colonsim.insertion.study.sweep_spec import load_sweep
 
     if args.scheduler is not None and args.workers is not None:
         raise ColonsimError("--workers is for local runs; a Dask cluster (--scheduler) has its own workers")

@@ -58,7 +58,7 @@ def calibrate_step(out: Path, show: bool):
 
 def insertion_step(material: Path, element_size: float, out: Path, show: bool):
     from colonsim.cli import run_insertions
-    from insertion.scenario import InsertionCase
+    from colonsim.insertion.case.scenario import InsertionCase
 
     _section("2/5 RSJ insertions (D = 36 mm, mu = 0) of the three scopes with the calibrated material; "
              "docs/validation/report.md compares this model with the source")
@@ -74,8 +74,8 @@ def insertion_step(material: Path, element_size: float, out: Path, show: bool):
 
 
 def sweep_step(material: Path, element_size: float, out: Path, workers: int, show: bool):
-    from insertion.sweep import run_sweep
-    from insertion.sweep_spec import parse_sweep
+    from colonsim.insertion.study.sweep import run_sweep
+    from colonsim.insertion.study.sweep_spec import parse_sweep
 
     text = DEMO_SWEEP.format(material=material.resolve().as_posix(), element_size=element_size)
     spec = parse_sweep(text, origin="demo sweep")
@@ -94,10 +94,10 @@ def sweep_step(material: Path, element_size: float, out: Path, workers: int, sho
 
 def surrogate_step(results: Path, out: Path):
     from colonsim.files import save_figure
-    from surrogate.model import SweepSurrogate
-    from surrogate.plot import prediction_figure
-    from surrogate.store import save_surrogate
-    from surrogate.table import read_results
+    from colonsim.surrogate.model import SweepSurrogate
+    from colonsim.surrogate.plot import prediction_figure
+    from colonsim.surrogate.store import save_surrogate
+    from colonsim.surrogate.table import read_results
 
     _section("4/5 Gaussian-process surrogate of the sweep (leave-one-out cross-validation)")
     model = SweepSurrogate(targets=SURROGATE_TARGETS, random_state=0).fit(read_results(results))
@@ -114,8 +114,8 @@ def surrogate_step(results: Path, out: Path):
 
 def recommend_step(model, out: Path):
     from colonsim.files import write_json
-    from surrogate.patients import describe_patient, patient_inputs
-    from surrogate.recommend import format_recommendation, recommend
+    from colonsim.surrogate.patients import describe_patient, patient_inputs
+    from colonsim.surrogate.recommend import format_recommendation, recommend
 
     _section("5/5 which scope deforms the colon least? two contrasting patients (RSJ)")
     recs = []
@@ -139,8 +139,8 @@ def write_report(out: Path, calibration, insertions, sweep, model, recs, seconds
     """``report.md``: what the demo ran, its main numbers and where each file is."""
     from colonsim.files import atomic_path
     from colonsim.markdown import frame_table
-    from insertion.results import comparison_table
-    from surrogate.recommend import format_recommendation
+    from colonsim.insertion.case.results import comparison_table
+    from colonsim.surrogate.recommend import format_recommendation
 
     sd = dict(zip(calibration.names, calibration.uncertainty.std))
     lines = ["# colonsim demo", "",
@@ -176,7 +176,7 @@ def write_report(out: Path, calibration, insertions, sweep, model, recs, seconds
 
 def print_summary(calibration, insertions, model, recs):
     """The demo's findings in a few lines."""
-    from identification.laws import get_law
+    from colonsim.identification.laws import get_law
 
     _section("summary")
     mu0 = get_law(calibration.model["law"]).initial_shear_modulus(calibration.parameters)

@@ -16,7 +16,7 @@ import re
 from dataclasses import dataclass
 
 from colonsim.errors import ColonsimError
-from identification.export_layout import parse_column_name, parse_number, unit_text
+from colonsim.identification.export_layout import parse_column_name, parse_number, unit_text
 
 QUANTITIES = ("length", "width", "thickness")
 # Keys naming a value at some event of the test, or another instrument's length.

@@ -1,6 +1,6 @@
 """Fitting every law the insertion solver can run to one curve, and choosing one by BIC.
 
-Each law of :data:`insertion.material.SOLVER_LAWS` goes through the same pipeline; the laws are
+Each law of :data:`colonsim.insertion.engine.material.SOLVER_LAWS` goes through the same pipeline; the laws are
 ranked by the Bayesian information criterion of their least-squares fit on the simulation
 points (Gaussian errors of unknown variance: ``n ln(RSS / n) + k ln n``, AIC with ``2 k``). A
 law with more parameters must lower the residual enough to pay for them, so a simpler law that
@@ -23,10 +23,10 @@ import pandas as pd
 from matplotlib.figure import Figure
 
 from colonsim.files import save_figure, write_csv, write_json
-from identification.diagnostics import parameters_at_bounds, shear_modulus
-from identification.laws import LAWS
-from identification.report import material_document, write_calibration
-from insertion.material import SOLVER_LAWS, solver_law_gap
+from colonsim.identification.diagnostics import parameters_at_bounds, shear_modulus
+from colonsim.identification.laws import LAWS
+from colonsim.identification.report import material_document, write_calibration
+from colonsim.insertion.engine.material import SOLVER_LAWS, solver_law_gap
 
 # Kass & Raftery's reading of a BIC difference (upper bound of each band).
 _EVIDENCE = ((2.0, "not worth more than a bare mention"), (6.0, "positive"), (10.0, "strong"), (np.inf, "very strong"))

@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from identification.laws import Law
+from colonsim.identification.laws import Law
 
 # d(cof F)/dF for 2x2 F: cof F = [F22, -F21, -F12, F11] is linear in F.
 _DCOF = np.zeros((4, 4))

@@ -10,9 +10,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from identification.specimen import ClampedStripModel, FEConvergenceError
-from identification.testdata import TensileCurve
-from identification.uniaxial import HomogeneousStripModel
+from colonsim.identification.specimen import ClampedStripModel, FEConvergenceError
+from colonsim.identification.testdata import TensileCurve
+from colonsim.identification.uniaxial import HomogeneousStripModel
 
 
 def make_model(curve: TensileCurve, law="mooney_rivlin_3", analytic=False, **mesh):

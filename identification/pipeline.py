@@ -24,12 +24,12 @@ from scipy import optimize, stats
 from scipy.stats import qmc
 
 from colonsim.errors import ColonsimError
-from identification.diagnostics import fit_against_noise, shear_modulus_weights
-from identification.objective import CurveObjective, make_model
-from identification.specimen import FEConvergenceError
-from identification.testdata import TensileCurve
-from identification.uniaxial import HomogeneousStripModel
-from identification.uncertainty import FitUncertainty, fit_uncertainty
+from colonsim.identification.diagnostics import fit_against_noise, shear_modulus_weights
+from colonsim.identification.objective import CurveObjective, make_model
+from colonsim.identification.specimen import FEConvergenceError
+from colonsim.identification.testdata import TensileCurve
+from colonsim.identification.uniaxial import HomogeneousStripModel
+from colonsim.identification.uncertainty import FitUncertainty, fit_uncertainty
 
 # docs/model.md: bounds and initial guess for the 3-parameter Mooney-Rivlin law, Pa.
 DEFAULT_BOUNDS = {"C10": (0.0, 0.06e6), "C01": (0.0, 0.06e6), "C11": (0.0, 2.5e6)}

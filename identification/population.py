@@ -16,10 +16,10 @@ import pandas as pd
 from matplotlib.figure import Figure
 
 from colonsim.files import save_figure, write_csv, write_json
-from identification.laws import get_law
-from identification.objective import CurveObjective, make_model
-from identification.pipeline import Budget, CalibrationResult, calibrate
-from identification.report import MATERIAL_FORMAT, write_calibration
+from colonsim.identification.laws import get_law
+from colonsim.identification.objective import CurveObjective, make_model
+from colonsim.identification.pipeline import Budget, CalibrationResult, calibrate
+from colonsim.identification.report import MATERIAL_FORMAT, write_calibration
 
 
 def calibrate_curve(curve, law="mooney_rivlin_3", analytic=False, budget=None, seed=1, bounds=None,

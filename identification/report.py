@@ -23,11 +23,11 @@ from matplotlib.figure import Figure
 
 from colonsim.files import save_figure, write_csv, write_json
 from colonsim.provenance import code_version
-from identification.diagnostics import identification_words, misfit_warning, shear_modulus
-from identification.laws import get_law
-from identification.pipeline import CalibrationResult
-from identification.testdata import source_records
-from insertion.material import solver_law_gap
+from colonsim.identification.diagnostics import identification_words, misfit_warning, shear_modulus
+from colonsim.identification.laws import get_law
+from colonsim.identification.pipeline import CalibrationResult
+from colonsim.identification.testdata import source_records
+from colonsim.insertion.engine.material import solver_law_gap
 
 MATERIAL_FORMAT = "colonsim-material/1"
 _STAGE_COLOURS = {"initial": "k", "sensitivity": "tab:gray", "cma-es": "tab:blue", "nelder-mead": "tab:red"}
@@ -50,7 +50,7 @@ def small_strain(result: CalibrationResult) -> dict:
 
 
 def material_document(result: CalibrationResult, level=0.95, selection=None) -> dict:
-    """The ``material.json`` document of one calibration (read by :mod:`insertion.material`);
+    """The ``material.json`` document of one calibration (read by :mod:`colonsim.insertion.engine.material`);
     ``selection`` records why this law was chosen when several were compared."""
     law = get_law(result.model["law"])
     unc = result.uncertainty.to_dict(level)

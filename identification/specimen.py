@@ -1,11 +1,11 @@
 """Finite-element model of the clamped tensile specimen (docs/model.md), built on scikit-fem.
 
-The strip is a thin incompressible sheet in plane stress (:mod:`identification.membrane`). By
+The strip is a thin incompressible sheet in plane stress (:mod:`colonsim.identification.membrane`). By
 symmetry only a quarter is meshed: ``0 <= X <= L/2`` (X = 0 is the mid-length plane, which does
 not move axially when the grips move by -d/2 and +d/2) and ``0 <= Y <= W/2`` (Y = 0 is the
 centre line, which does not move laterally). The grip at X = L/2 moves axially by d/2; with
 ``grips="clamped"`` it cannot contract laterally, with ``grips="sliding"`` it can (which makes
-the state homogeneous and reproduces :func:`identification.uniaxial.homogeneous_force`).
+the state homogeneous and reproduces :func:`colonsim.identification.uniaxial.homogeneous_force`).
 
 Why it is fast: scikit-fem supplies the mesh, the quadratic (P2) basis and the quadrature once;
 the Newton loop then works on precomputed shape-function gradients with vectorised numpy (the
@@ -22,8 +22,8 @@ from scipy.sparse.linalg import splu
 from skfem import Basis, ElementTriP1, ElementTriP2, MeshTri
 
 from colonsim.errors import ColonsimError
-from identification.laws import get_law
-from identification.membrane import membrane_stress
+from colonsim.identification.laws import get_law
+from colonsim.identification.membrane import membrane_stress
 
 
 class FEConvergenceError(ColonsimError):
@@ -38,7 +38,7 @@ class ClampedStripModel:
     length, width, thickness : float
         Free length between the grips, width and wall thickness of the strip, m.
     law : Law or str
-        Hyperelastic law (:data:`identification.laws.LAWS`), default 3-parameter Mooney-Rivlin.
+        Hyperelastic law (:data:`colonsim.identification.laws.LAWS`), default 3-parameter Mooney-Rivlin.
     grips : {"clamped", "sliding"}
         Clamped grips forbid lateral motion at the gripped edges (the real test).
     n_length, n_width : int

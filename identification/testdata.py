@@ -4,11 +4,11 @@ A curve file holds one displacement column and one force column whose units are 
 header (``displacement [mm],force [N]``, ``Extension (mm)``, ``force_N``), in a units row under
 it, or given explicitly (``displacement_unit=``, ``force_unit=``). Exports with a preamble of
 test parameters, a units row, a decimal comma, tabs or semicolons, a Windows code page and
-summary rows after the data are read as written (:mod:`identification.export_layout`).
+summary rows after the data are read as written (:mod:`colonsim.identification.export_layout`).
 
 Geometry is never guessed: free length, width and thickness come from the caller, a manifest CSV
 (``specimen,file,length_mm,width_mm,thickness_mm``, paths relative to the manifest) or the
-file's own preamble (:mod:`identification.export_geometry`); a value given wins over the
+file's own preamble (:mod:`colonsim.identification.export_geometry`); a value given wins over the
 preamble's, and a disagreement is reported.
 
 Everything is converted to SI (m, N) on the way in.
@@ -24,8 +24,8 @@ from pathlib import Path
 import numpy as np
 
 from colonsim.errors import ColonsimError
-from identification.export_geometry import stated_geometry
-from identification.export_layout import parse_column_name, read_export, read_text, unit_text
+from colonsim.identification.export_geometry import stated_geometry
+from colonsim.identification.export_layout import parse_column_name, read_export, read_text, unit_text
 
 LENGTH_UNITS = {"m": 1.0, "cm": 1e-2, "mm": 1e-3, "um": 1e-6, "µm": 1e-6, "in": 0.0254}
 FORCE_UNITS = {"n": 1.0, "kn": 1e3, "mn": 1e-3, "gf": 9.80665e-3, "kgf": 9.80665, "lbf": 4.4482216152605}  # keys lower-case

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from identification.laws import Law
+from colonsim.identification.laws import Law
 
 
 def uniaxial_invariants(stretch):
@@ -38,7 +38,7 @@ def tangent_modulus(stretch, law: Law, params, h=1e-6):
 
 
 class HomogeneousStripModel:
-    """Closed-form stand-in for :class:`identification.specimen.ClampedStripModel`.
+    """Closed-form stand-in for :class:`colonsim.identification.specimen.ClampedStripModel`.
 
     Same ``solve(params, displacements)`` interface; ignores the grips, so it is softer than the
     clamped FE model by a few percent (the reason the source used inverse FE).
@@ -47,7 +47,7 @@ class HomogeneousStripModel:
     grips = "none (homogeneous)"
 
     def __init__(self, length, width, thickness, law="mooney_rivlin_3"):
-        from identification.laws import get_law
+        from colonsim.identification.laws import get_law
 
         self.length, self.width, self.thickness = float(length), float(width), float(thickness)
         self.law = get_law(law) if isinstance(law, str) else law

@@ -15,20 +15,21 @@ from pathlib import Path
 
 import numpy as np
 
-from identification.laws import get_law
-from identification.membrane import membrane_stress
-from identification.pipeline import Budget, CalibrationResult
-from identification.population import calibrate_curve
-from identification.specimen import ClampedStripModel
-from identification.testdata import TensileCurve, read_manifest
-from identification.uniaxial import homogeneous_force, nominal_stress
+from colonsim.data import TENSILE_DIR
+from colonsim.identification.laws import get_law
+from colonsim.identification.membrane import membrane_stress
+from colonsim.identification.pipeline import Budget, CalibrationResult
+from colonsim.identification.population import calibrate_curve
+from colonsim.identification.specimen import ClampedStripModel
+from colonsim.identification.testdata import TensileCurve, read_manifest
+from colonsim.identification.uniaxial import homogeneous_force, nominal_stress
 
 # docs/model.md: the source's identified parameters (C10, C01, C11), Pa.
 REFERENCE = np.array([652.01, 42835.25, 219120.3])
 # docs/model.md: free length and width of the source's strips, m; thickness 2 mm (an assumption).
 STRIP = (0.1, 0.025, 0.002)
 DISPLACEMENTS = np.linspace(3e-3, 60e-3, 6)  # up to 60 % strain, the end of the test
-DATA = Path(__file__).resolve().parents[1] / "data" / "tensile"
+DATA = TENSILE_DIR
 NAMES = ("C10", "C01", "C11")
 
 

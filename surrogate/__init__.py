@@ -6,10 +6,10 @@ output, cross-validated at fit time) -> JSON + NPZ files (:func:`save_surrogate`
 recommendations. See docs/surrogate.md.
 """
 
-from surrogate.domain import OutOfDomainWarning, SegmentDomain
-from surrogate.gp import GaussianProcess
-from surrogate.model import SweepSurrogate
-from surrogate.table import INPUTS, SEGMENTS, TARGETS, read_results
+from colonsim.surrogate.domain import OutOfDomainWarning, SegmentDomain
+from colonsim.surrogate.gp import GaussianProcess
+from colonsim.surrogate.model import SweepSurrogate
+from colonsim.surrogate.table import INPUTS, SEGMENTS, TARGETS, read_results
 
 __all__ = ["GaussianProcess", "INPUTS", "OutOfDomainWarning", "SEGMENTS", "SegmentDomain", "SweepSurrogate",
            "TARGETS", "read_results"]

@@ -14,7 +14,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from colonsim.errors import ColonsimError, ColonsimWarning
-from surrogate.table import INPUT_OPTIONS, INPUTS
+from colonsim.surrogate.table import INPUT_OPTIONS, INPUTS
 
 # Relative slack of the bounds (a fraction of the range, or of the value for a fixed input), so
 # that round-off in a query ("9.2" vs 9.200000001) is not "outside".

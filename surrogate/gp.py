@@ -15,8 +15,8 @@ from scipy.linalg import cho_solve, cholesky, solve_triangular
 from scipy.optimize import minimize
 
 from colonsim.errors import ColonsimError
-from surrogate.kernel import matern52
-from surrogate.likelihood import JITTER, log_marginal_likelihood
+from colonsim.surrogate.kernel import matern52
+from colonsim.surrogate.likelihood import JITTER, log_marginal_likelihood
 
 
 class GaussianProcess:

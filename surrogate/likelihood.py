@@ -16,7 +16,7 @@ import numpy as np
 from scipy.linalg import cho_solve, cholesky
 from scipy.linalg.lapack import dpotri
 
-from surrogate.kernel import SQRT5
+from colonsim.surrogate.kernel import SQRT5
 
 JITTER = 1e-10  # added to the diagonal, as scikit-learn's GaussianProcessRegressor(alpha=1e-10)
 

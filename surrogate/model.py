@@ -13,11 +13,11 @@ import numpy as np
 import pandas as pd
 
 from colonsim.errors import ColonsimError
-from surrogate.domain import SegmentDomain
-from surrogate.gp import GaussianProcess
-from surrogate.table import (INPUT_OPTIONS, INPUTS, TARGETS, check_results, numeric_column, scope_diameter_mm,
+from colonsim.surrogate.domain import SegmentDomain
+from colonsim.surrogate.gp import GaussianProcess
+from colonsim.surrogate.table import (INPUT_OPTIONS, INPUTS, TARGETS, check_results, numeric_column, scope_diameter_mm,
                              scope_diameters, solver_settings, split_inputs, successful_runs)
-from surrogate.validation import Z95, cross_validate
+from colonsim.surrogate.validation import Z95, cross_validate
 
 
 class SweepSurrogate:
@@ -26,14 +26,14 @@ class SweepSurrogate:
     Parameters
     ----------
     targets : sequence of str
-        Output columns to model (default :data:`surrogate.table.TARGETS`); a segment whose runs
+        Output columns to model (default :data:`colonsim.surrogate.table.TARGETS`); a segment whose runs
         leave a target undefined (NaN, e.g. points A and C outside RSJ) gets no model for it.
     inputs : sequence of str
         Candidate input columns; those constant over a segment's runs are recorded as fixed.
     segments : sequence of str or None
         Segments to fit (default: all in the table).
     cv : "loo" or int
-        Cross-validation scheme run at fit time (see :mod:`surrogate.validation`).
+        Cross-validation scheme run at fit time (see :mod:`colonsim.surrogate.validation`).
     n_restarts : int
         Extra optimizer starts of each GP's hyperparameters.
     min_runs : int

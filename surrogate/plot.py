@@ -6,9 +6,9 @@ import numpy as np
 from matplotlib.figure import Figure
 
 from colonsim.errors import ColonsimError
-from surrogate.recommend import default_scopes
-from surrogate.table import INPUT_LABELS, TARGET_LABELS, scope_diameter_mm
-from surrogate.validation import Z95
+from colonsim.surrogate.recommend import default_scopes
+from colonsim.surrogate.table import INPUT_LABELS, TARGET_LABELS, scope_diameter_mm
+from colonsim.surrogate.validation import Z95
 
 
 def prediction_figure(model, segment, vs, inputs: dict, target="final_deformation_cm", scopes=None, points=120,

@@ -25,8 +25,8 @@ import numpy as np
 from scipy.special import ndtr
 
 from colonsim.errors import ColonsimError
-from surrogate.table import NAMED_SCOPES_MM, STANDARD_SCOPE, scope_diameter_mm, target_unit
-from surrogate.validation import Z95
+from colonsim.surrogate.table import NAMED_SCOPES_MM, STANDARD_SCOPE, scope_diameter_mm, target_unit
+from colonsim.surrogate.validation import Z95
 
 
 def default_scopes(domain):

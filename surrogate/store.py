@@ -21,9 +21,9 @@ from colonsim import __version__
 from colonsim.provenance import code_version
 from colonsim.errors import ColonsimError
 from colonsim.files import atomic_paths, json_text
-from surrogate.domain import SegmentDomain
-from surrogate.gp import GaussianProcess
-from surrogate.model import SweepSurrogate
+from colonsim.surrogate.domain import SegmentDomain
+from colonsim.surrogate.gp import GaussianProcess
+from colonsim.surrogate.model import SweepSurrogate
 
 FORMAT = "colonsim-surrogate"
 FORMAT_VERSION = "1.0"

@@ -12,7 +12,7 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from surrogate.table import NAMED_SCOPES_MM
+from colonsim.surrogate.table import NAMED_SCOPES_MM
 
 
 def synthetic_deformation(scope_diameter_mm, diameter_mm, angle_deg, friction):

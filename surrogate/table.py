@@ -155,7 +155,7 @@ def scope_diameters(runs: pd.DataFrame) -> dict:
     return {str(s).strip().lower(): float(d) for s, d in zip(pairs["scope"], pairs["scope_diameter_mm"])}
 
 
-# docs/model.md (the same numbers as insertion.scopes.NAMED_SCOPES, kept here so that reading a
+# docs/model.md (the same numbers as colonsim.insertion.anatomy.scopes.NAMED_SCOPES, kept here so that reading a
 # surrogate does not import the solver); a sweep table's own scope column takes precedence.
 NAMED_SCOPES_MM = {"utc": 9.2, "pdc": 11.3, "sdc": 12.8}
 SMALL_CALIBER = ("utc", "pdc")

@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import numpy as np
 from colonsim.errors import ColonsimError
-from surrogate.likelihood import inverse_from_cholesky
+from colonsim.surrogate.likelihood import inverse_from_cholesky
 
 Z95 = 1.959963984540054
 

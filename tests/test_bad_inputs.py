@@ -16,10 +16,10 @@ import pandas as pd
 import pytest
 
 from colonsim.cli import main
-from insertion.material import REFERENCE_MATERIAL_PATH
-from insertion.sweep import SweepStore
-from insertion.sweep_spec import parse_sweep
-from surrogate.synthetic import synthetic_sweep
+from colonsim.insertion.engine.material import REFERENCE_MATERIAL_PATH
+from colonsim.insertion.study.sweep import SweepStore
+from colonsim.insertion.study.sweep_spec import parse_sweep
+from colonsim.surrogate.synthetic import synthetic_sweep
 
 DATA = Path(__file__).resolve().parents[1] / "data" / "tensile"
 CURVE = str(DATA / "specimen_01.csv")

@@ -6,14 +6,14 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from identification.laws import get_law
-from identification.objective import CurveObjective, make_model
-from identification.pipeline import Budget, calibrate
-from identification.report import write_calibration
-from identification.testdata import TensileCurve
-from identification.uniaxial import homogeneous_force
-from identification.verification import specimen_recovery
-from insertion.material import load_material
+from colonsim.identification.laws import get_law
+from colonsim.identification.objective import CurveObjective, make_model
+from colonsim.identification.pipeline import Budget, calibrate
+from colonsim.identification.report import write_calibration
+from colonsim.identification.testdata import TensileCurve
+from colonsim.identification.uniaxial import homogeneous_force
+from colonsim.identification.verification import specimen_recovery
+from colonsim.insertion.engine.material import load_material
 
 DATA = Path(__file__).resolve().parents[1] / "data" / "tensile"
 TRUTH = json.loads((DATA / "ground_truth.json").read_text())

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from colonsim.errors import ColonsimError
-from insertion.centerline import (EXIT_LENGTH, FILLET_RADIUS, FLEXURE_ANGLE_DEG, FLEXURE_RADIUS, Arc, Centerline,
+from colonsim.insertion.anatomy.centerline import (EXIT_LENGTH, FILLET_RADIUS, FLEXURE_ANGLE_DEG, FLEXURE_RADIUS, Arc, Centerline,
                                   Kink, Straight, rsf_centerline, rsj_centerline, thf_centerline, thf_fixed_centerline)
 
 R, RF = FLEXURE_RADIUS, FILLET_RADIUS

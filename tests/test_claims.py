@@ -1,4 +1,4 @@
-"""The claim evaluations of insertion.claims on small hand-built results tables."""
+"""The claim evaluations of colonsim.insertion.study.claims on small hand-built results tables."""
 
 import itertools
 import math
@@ -7,10 +7,10 @@ import pandas as pd
 import pytest
 
 from colonsim.errors import ColonsimError
-from insertion.claims import (NOT_EVALUATED, NOT_REPRODUCED, REPRODUCED, angle_dependence, evaluate_claims,
+from colonsim.insertion.study.claims import (NOT_EVALUATED, NOT_REPRODUCED, REPRODUCED, angle_dependence, evaluate_claims,
                               reduction_larger_at_small_diameter, rsj_ordering, sc_deform_less_rsj,
                               sc_less_friction_sensitive)
-from insertion.reference import source_rsj_table
+from colonsim.insertion.study.reference import source_rsj_table
 
 # Hand-built RSJ deformations (cm): SDC 4.0, PDC 3.0, UTC 2.0 at D 36, friction adds 0.5 mu/0.1 to
 # SDC and less to the small scopes; D 23 is 10 % deeper for SDC, less for the others.
@@ -161,7 +161,7 @@ def test_two_runs_of_one_case_are_an_error():
 
 
 def test_advantage_floor():
-    from insertion.claims import NO_DEFORMATION_CM, advantage
+    from colonsim.insertion.study.claims import NO_DEFORMATION_CM, advantage
 
     assert advantage(4.0, 3.0) == pytest.approx(0.25)
     assert advantage(0.5 * NO_DEFORMATION_CM, 0.0) == 0.0  # nothing measurable

@@ -4,11 +4,11 @@ import numpy as np
 import pytest
 
 from colonsim.errors import ColonsimError
-from insertion.centerline import (Arc, Centerline, Kink, Straight, rsf_centerline, rsj_centerline, thf_centerline,
+from colonsim.insertion.anatomy.centerline import (Arc, Centerline, Kink, Straight, rsf_centerline, rsj_centerline, thf_centerline,
                                   thf_fixed_centerline)
-from insertion.colon_geometry import enclosed_volume, tube_mesh
-from insertion.reference import SOURCE_MESHES
-from insertion.sheet_mesh import hinges
+from colonsim.insertion.anatomy.colon_geometry import enclosed_volume, tube_mesh
+from colonsim.insertion.study.reference import SOURCE_MESHES
+from colonsim.insertion.engine.sheet_mesh import hinges
 
 H = 3e-3
 

@@ -1,9 +1,9 @@
 """Regularised Coulomb friction: a rod on a wall sticks below mu N and slides above it
-(the problem is built in :func:`insertion.verification.friction_slide`)."""
+(the problem is built in :func:`colonsim.insertion.study.verification.friction_slide`)."""
 
 import pytest
 
-from insertion.verification import friction_slide
+from colonsim.insertion.study.verification import friction_slide
 
 MU = 0.3
 N = 1.0  # total normal load, N

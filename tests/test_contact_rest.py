@@ -3,12 +3,12 @@
 import numpy as np
 import pytest
 
-from insertion.contact import RodShellContact
-from insertion.material import REFERENCE_MATERIAL_PATH, load_material
-from insertion.rod import Rod
-from insertion.sheet_mesh import straight_tube
-from insertion.shell import Shell
-from insertion.verification import SCOPE_D, SCOPE_E, SCOPE_RHO, WALL_T, rod_on_sheet, rod_resting_on_wall, tip_on_node
+from colonsim.insertion.engine.contact import RodShellContact
+from colonsim.insertion.engine.material import REFERENCE_MATERIAL_PATH, load_material
+from colonsim.insertion.engine.rod import Rod
+from colonsim.insertion.engine.sheet_mesh import straight_tube
+from colonsim.insertion.engine.shell import Shell
+from colonsim.insertion.study.verification import SCOPE_D, SCOPE_E, SCOPE_RHO, WALL_T, rod_on_sheet, rod_resting_on_wall, tip_on_node
 
 E, RHO, D, T = SCOPE_E, SCOPE_RHO, SCOPE_D, WALL_T
 

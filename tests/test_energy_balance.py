@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from insertion.verification import damped_push_energy_balance, free_vibration_energy_drift
+from colonsim.insertion.study.verification import damped_push_energy_balance, free_vibration_energy_drift
 
 
 def test_undamped_free_vibration_conserves_energy():

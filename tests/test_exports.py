@@ -9,7 +9,7 @@ import pytest
 
 from colonsim.cli import main
 from colonsim.errors import ColonsimError
-from identification.testdata import CurveWarning, TensileCurve, read_curve, read_manifest
+from colonsim.identification.testdata import CurveWarning, TensileCurve, read_curve, read_manifest
 
 ROOT = Path(__file__).resolve().parents[1]
 EXPORTS = ROOT / "tests" / "data" / "exports"

@@ -10,16 +10,16 @@ import pytest
 
 from colonsim.cli import main
 from colonsim.errors import ColonsimError
-from identification.diagnostics import (identification_words, interpolation_variance, misfit_warning, noise_sd,
+from colonsim.identification.diagnostics import (identification_words, interpolation_variance, misfit_warning, noise_sd,
                                         shear_modulus)
-from identification.law_comparison import compare_laws, information_criteria
-from identification.laws import LAWS, get_law
-from identification.objective import CurveObjective, make_model
-from identification.pipeline import Budget, calibrate
-from identification.report import material_document
-from identification.testdata import TensileCurve
-from identification.uniaxial import homogeneous_force
-from insertion.material import SOLVER_LAWS, load_material, solver_law_gap
+from colonsim.identification.law_comparison import compare_laws, information_criteria
+from colonsim.identification.laws import LAWS, get_law
+from colonsim.identification.objective import CurveObjective, make_model
+from colonsim.identification.pipeline import Budget, calibrate
+from colonsim.identification.report import material_document
+from colonsim.identification.testdata import TensileCurve
+from colonsim.identification.uniaxial import homogeneous_force
+from colonsim.insertion.engine.material import SOLVER_LAWS, load_material, solver_law_gap
 
 BUDGET = Budget(designs=40, cma_popsize=10, cma_max_evaluations=200, nm_max_evaluations=400)
 NOISE = 0.05  # N, the load-cell noise of the bundled synthetic data

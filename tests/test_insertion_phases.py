@@ -7,7 +7,7 @@ A 6 mm wall mesh keeps the run to seconds; the phases and the constraint do not 
 import numpy as np
 import pytest
 
-from insertion.scenario import InsertionCase, run_insertion
+from colonsim.insertion.case.scenario import InsertionCase, run_insertion
 
 
 @pytest.fixture(scope="module")

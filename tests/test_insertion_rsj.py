@@ -12,8 +12,8 @@ import os
 import numpy as np
 import pytest
 
-from insertion.colon_segments import PAST_JUNCTION
-from insertion.scenario import InsertionCase, run_insertion
+from colonsim.insertion.anatomy.colon_segments import PAST_JUNCTION
+from colonsim.insertion.case.scenario import InsertionCase, run_insertion
 
 SIZE_MM = 3.0 if os.environ.get("COLONSIM_FULL") == "1" else 4.0
 

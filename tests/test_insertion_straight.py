@@ -5,7 +5,7 @@ import json
 import pytest
 
 from colonsim.cli import main
-from insertion.scenario import InsertionCase, run_insertion
+from colonsim.insertion.case.scenario import InsertionCase, run_insertion
 
 
 @pytest.fixture(scope="module")

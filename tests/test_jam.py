@@ -3,10 +3,10 @@
 import numpy as np
 import pytest
 
-import insertion.scenario as scenario
-from insertion.colon_segments import straight_colon
-from insertion.scenario import InsertionCase, run_insertion
-from insertion.solver import PrescribedVelocity
+import colonsim.insertion.case.scenario as scenario
+from colonsim.insertion.anatomy.colon_segments import straight_colon
+from colonsim.insertion.case.scenario import InsertionCase, run_insertion
+from colonsim.insertion.engine.solver import PrescribedVelocity
 
 STENOSIS_X = 0.10  # m along the straight tube
 STENOSIS_RADIUS = 2e-3  # m: a held iris far narrower than any scope

@@ -4,8 +4,8 @@ import numpy as np
 import pytest
 
 from colonsim.errors import ColonsimError
-from identification.laws import get_law
-from identification.uniaxial import homogeneous_force, nominal_stress, tangent_modulus, uniaxial_invariants
+from colonsim.identification.laws import get_law
+from colonsim.identification.uniaxial import homogeneous_force, nominal_stress, tangent_modulus, uniaxial_invariants
 
 REFERENCE = (652.01, 42835.25, 219120.3)  # docs/model.md, Pa
 

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from colonsim.errors import ColonsimError
-from insertion.manoeuvre import continuous_push, straighten_relax_push
+from colonsim.insertion.anatomy.manoeuvre import continuous_push, straighten_relax_push
 
 
 def test_continuous_push_reaches_the_depth_smoothly():

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from colonsim.errors import ColonsimError
-from insertion.material import REFERENCE_MATERIAL_PATH, MooneyRivlin, load_material
+from colonsim.insertion.engine.material import REFERENCE_MATERIAL_PATH, MooneyRivlin, load_material
 
 
 def write(tmp_path, data, name="mat.json"):
@@ -143,7 +143,7 @@ def test_integer_parameters_become_floats(tmp_path):
 
 def test_a_wall_softer_than_any_tissue_is_loaded_with_a_warning(tmp_path, capsys):
     from colonsim.cli import main
-    from insertion.material import SoftWallWarning
+    from colonsim.insertion.engine.material import SoftWallWarning
 
     soft = write(tmp_path, good(parameters={"C10": 1e-6, "C01": 0.0, "C11": 0.0}))
     with pytest.warns(SoftWallWarning, match="2e-06 Pa is softer than any soft tissue"):

@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from insertion.outcomes import (JAM_PROGRESS, JAM_PUSH, characteristic_points, jammed, principal_stretches,
+from colonsim.insertion.case.outcomes import (JAM_PROGRESS, JAM_PUSH, characteristic_points, jammed, principal_stretches,
                                 quasi_static_fraction, sliding_kinetic_energy)
 
 
@@ -46,7 +46,7 @@ def test_quasi_static_fraction():
 
 
 def test_principal_stretch_of_a_stretched_and_rotated_triangle():
-    from insertion.shell import reference_frames
+    from colonsim.insertion.engine.shell import reference_frames
 
     nodes = np.array([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]])
     tri = np.array([[0, 1, 2]])

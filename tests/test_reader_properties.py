@@ -10,7 +10,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from colonsim.errors import ColonsimError
-from identification.testdata import CurveWarning, read_curve
+from colonsim.identification.testdata import CurveWarning, read_curve
 
 DISPLACEMENTS = ["displacement", "Extension", "Standard travel", "Axial Displacement ", "Stroke", "Position", "Weg"]
 FORCES = ["force", "Load", "Standard force", "Kraft", "Axial Force "]

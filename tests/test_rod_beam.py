@@ -1,6 +1,6 @@
 """Rod against beam theory: cantilever tip deflection, Euler buckling, axial wave speed.
 
-The problems are built and solved in :mod:`insertion.verification` (which the validation report
+The problems are built and solved in :mod:`colonsim.insertion.study.verification` (which the validation report
 also tabulates). The rod's hinge at the first free node owns the half cell behind it, so a rod
 whose first two nodes are fixed is clamped at the middle of its first segment: the beam length is
 measured from there (x = h/2) to the tip node.
@@ -11,8 +11,8 @@ import math
 import numpy as np
 import pytest
 
-from insertion.rod import Rod
-from insertion.verification import (SCOPE_D, SCOPE_E, SCOPE_RHO, axial_wave, cantilever, cantilever_tip_deflection,
+from colonsim.insertion.engine.rod import Rod
+from colonsim.insertion.study.verification import (SCOPE_D, SCOPE_E, SCOPE_RHO, axial_wave, cantilever, cantilever_tip_deflection,
                                     compressed_min_eigenvalue, euler_buckling_load, euler_load)
 
 E, RHO, D = SCOPE_E, SCOPE_RHO, SCOPE_D  # the standard scope (catalogue diameter)

@@ -6,7 +6,7 @@ import os
 
 import pytest
 
-from insertion.verification import beam_column_tip_deflection, buckling_tip_deflection, elastica_tip_deflection
+from colonsim.insertion.study.verification import beam_column_tip_deflection, buckling_tip_deflection, elastica_tip_deflection
 
 FULL = os.environ.get("COLONSIM_FULL") == "1"
 

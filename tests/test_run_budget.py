@@ -8,9 +8,9 @@ import pytest
 
 from colonsim.cli import main
 from colonsim.errors import ColonsimError
-from insertion.material import REFERENCE_MATERIAL_PATH
-from insertion.run_budget import check_run_budget, check_sweep_budget, estimate_run
-from insertion.scenario import InsertionCase
+from colonsim.insertion.engine.material import REFERENCE_MATERIAL_PATH
+from colonsim.insertion.case.run_budget import check_run_budget, check_sweep_budget, estimate_run
+from colonsim.insertion.case.scenario import InsertionCase
 
 COARSE = dict(segment="straight", scope="pdc", element_size_mm=7.5)
 

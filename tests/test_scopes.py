@@ -5,7 +5,7 @@ import math
 import pytest
 
 from colonsim.errors import ColonsimError
-from insertion.scopes import colonoscope
+from colonsim.insertion.anatomy.scopes import colonoscope
 
 
 def test_named_scopes_and_material():

@@ -1,6 +1,6 @@
 """Hinge bending of the shell against plate theory.
 
-A flat near-equilateral sheet (built, with the maps, in :mod:`insertion.verification`) is mapped isometrically onto a cylinder of radius R; the hinge
+A flat near-equilateral sheet (built, with the maps, in :mod:`colonsim.insertion.study.verification`) is mapped isometrically onto a cylinder of radius R; the hinge
 energy per unit area of the sheet's interior must be the plate value D / (2 R^2) with
 D = E0 t^3 / 9 (nu = 1/2), whatever the cylinder's direction relative to the mesh.
 """
@@ -8,9 +8,9 @@ D = E0 t^3 / 9 (nu = 1/2), whatever the cylinder's direction relative to the mes
 import numpy as np
 import pytest
 
-from insertion.sheet_mesh import straight_tube
-from insertion.shell import Shell
-from insertion.verification import (WALL_T, bending_sheet, cylinder_bending, onto_cylinder,
+from colonsim.insertion.engine.sheet_mesh import straight_tube
+from colonsim.insertion.engine.shell import Shell
+from colonsim.insertion.study.verification import (WALL_T, bending_sheet, cylinder_bending, onto_cylinder,
                                     reference_material, sphere_bending)
 
 MATERIAL = reference_material()

@@ -4,9 +4,9 @@ import numpy as np
 import pytest
 
 from colonsim.errors import ColonsimError
-from insertion.material import REFERENCE_MATERIAL_PATH, load_material
-from insertion.sheet_mesh import straight_tube
-from insertion.shell import Shell
+from colonsim.insertion.engine.material import REFERENCE_MATERIAL_PATH, load_material
+from colonsim.insertion.engine.sheet_mesh import straight_tube
+from colonsim.insertion.engine.shell import Shell
 
 MATERIAL = load_material(REFERENCE_MATERIAL_PATH)
 RADIUS, THICKNESS, LENGTH, H = 0.018, 0.002, 0.03, 0.003

@@ -8,9 +8,9 @@ import numpy as np
 import pytest
 
 from colonsim.errors import ColonsimError
-from insertion.material import REFERENCE_MATERIAL_PATH, load_material
-from insertion.sheet_mesh import straight_tube
-from insertion.shell import Shell, _atan2
+from colonsim.insertion.engine.material import REFERENCE_MATERIAL_PATH, load_material
+from colonsim.insertion.engine.sheet_mesh import straight_tube
+from colonsim.insertion.engine.shell import Shell, _atan2
 
 MATERIAL = load_material(REFERENCE_MATERIAL_PATH)
 

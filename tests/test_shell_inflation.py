@@ -22,7 +22,7 @@ import os
 import numpy as np
 import pytest
 
-from insertion.verification import (TUBE_RADIUS, WALL_T, inflate_clamped_tube, inflate_section, inflation_tube,
+from colonsim.insertion.study.verification import (TUBE_RADIUS, WALL_T, inflate_clamped_tube, inflate_section, inflation_tube,
                                     reference_material, thin_wall_pressure)
 
 FULL = os.environ.get("COLONSIM_FULL") == "1"

@@ -5,12 +5,12 @@ import numpy as np
 import pytest
 
 from colonsim.errors import ColonsimError
-from identification.laws import get_law
-from identification.uniaxial import nominal_stress
-from insertion.material import MooneyRivlin, REFERENCE_MATERIAL_PATH, load_material
-from insertion.sheet_mesh import flat_sheet
-from insertion.shell import Shell
-from insertion.statics import minimize_energy
+from colonsim.identification.laws import get_law
+from colonsim.identification.uniaxial import nominal_stress
+from colonsim.insertion.engine.material import MooneyRivlin, REFERENCE_MATERIAL_PATH, load_material
+from colonsim.insertion.engine.sheet_mesh import flat_sheet
+from colonsim.insertion.engine.shell import Shell
+from colonsim.insertion.engine.statics import minimize_energy
 
 REFERENCE = load_material(REFERENCE_MATERIAL_PATH)
 MATERIALS = {
@@ -59,7 +59,7 @@ def test_uniaxial_stretch_matches_closed_form(name, rotated):
 
     Constant-strain triangles represent a homogeneous deformation exactly, so the closed form must
     hold to round-off: the axial grip force equals P(l) W t with P from
-    ``identification.uniaxial.nominal_stress`` (independent code), every node off the grips is in
+    ``colonsim.identification.uniaxial.nominal_stress`` (independent code), every node off the grips is in
     equilibrium, and no node carries a lateral force (plane stress, free lateral contraction), all
     to 1e-9 of the grip force; the energy equals W(l) L W t. ``rotated`` puts the sheet at an
     arbitrary orientation in space (frame invariance).

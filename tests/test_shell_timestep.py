@@ -4,9 +4,9 @@ exact largest eigenfrequency of the assembled, lumped-mass system."""
 import numpy as np
 import pytest
 
-from insertion.material import REFERENCE_MATERIAL_PATH, load_material
-from insertion.sheet_mesh import straight_tube
-from insertion.shell import Shell
+from colonsim.insertion.engine.material import REFERENCE_MATERIAL_PATH, load_material
+from colonsim.insertion.engine.sheet_mesh import straight_tube
+from colonsim.insertion.engine.shell import Shell
 
 MATERIAL = load_material(REFERENCE_MATERIAL_PATH)
 DENSITY = 1040.0

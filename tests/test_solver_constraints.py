@@ -5,8 +5,8 @@ import math
 import numpy as np
 import pytest
 
-from insertion.rod import Rod
-from insertion.solver import ExplicitSolver, FixedNodes, LineConstraint, NodalLoad
+from colonsim.insertion.engine.rod import Rod
+from colonsim.insertion.engine.solver import ExplicitSolver, FixedNodes, LineConstraint, NodalLoad
 
 E = 16e6
 RHO = 2944.0

@@ -2,14 +2,14 @@
 
 import numpy as np
 
-import insertion.solver
+import colonsim.insertion.engine.solver
 
 
 def test_docstring_example_runs():
     # The scope starts 1 cm below the axis in a 36 mm lumen and is pushed at 60 cm/s for 5 ms
     # (3 mm of travel with a 2 ms ramp, 1 mm of it ramping): the tip does not reach the wall,
     # so the push force is the scope's inertia + damping (positive) and no contact is active.
-    code = insertion.solver.__doc__.split("Example (run by the test suite)::")[1]
+    code = colonsim.insertion.engine.solver.__doc__.split("Example (run by the test suite)::")[1]
     scope = {}
     exec(compile("\n".join(line[4:] for line in code.splitlines()), "solver-example", "exec"), scope)
     history = scope["history"]

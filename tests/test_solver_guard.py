@@ -4,8 +4,8 @@ import numpy as np
 import pytest
 
 from colonsim.errors import ColonsimError
-from insertion.rod import Rod
-from insertion.solver import ExplicitSolver, FixedNodes, PrescribedVelocity
+from colonsim.insertion.engine.rod import Rod
+from colonsim.insertion.engine.solver import ExplicitSolver, FixedNodes, PrescribedVelocity
 
 E = 16e6
 RHO = 2944.0

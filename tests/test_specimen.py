@@ -4,10 +4,10 @@ import numpy as np
 import pytest
 
 from colonsim.errors import ColonsimError
-from identification.laws import get_law
-from identification.membrane import membrane_stress
-from identification.specimen import ClampedStripModel, FEConvergenceError
-from identification.verification import (DISPLACEMENTS, REFERENCE, STRIP, membrane_uniaxial_stress, mesh_convergence,
+from colonsim.identification.laws import get_law
+from colonsim.identification.membrane import membrane_stress
+from colonsim.identification.specimen import ClampedStripModel, FEConvergenceError
+from colonsim.identification.verification import (DISPLACEMENTS, REFERENCE, STRIP, membrane_uniaxial_stress, mesh_convergence,
                                          specimen_against_closed_form)
 
 L, W, T = STRIP

@@ -7,7 +7,7 @@ import pandas as pd
 import pytest
 
 from colonsim.cli import main
-from surrogate.synthetic import synthetic_sweep
+from colonsim.surrogate.synthetic import synthetic_sweep
 
 
 @pytest.fixture(scope="module")

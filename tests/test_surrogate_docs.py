@@ -10,8 +10,8 @@ from pathlib import Path
 import pytest
 
 from colonsim.cli import main
-from surrogate.patients import PatientPresets, patient_inputs
-from surrogate.synthetic import synthetic_sweep
+from colonsim.surrogate.patients import PatientPresets, patient_inputs
+from colonsim.surrogate.synthetic import synthetic_sweep
 
 DOC = Path(__file__).resolve().parents[1] / "docs" / "surrogate.md"
 

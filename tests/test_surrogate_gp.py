@@ -9,9 +9,9 @@ import pytest
 from sklearn.gaussian_process import GaussianProcessRegressor
 from sklearn.gaussian_process.kernels import ConstantKernel, Matern, WhiteKernel
 
-from surrogate.gp import GaussianProcess
-from surrogate.likelihood import log_marginal_likelihood
-from surrogate.validation import Z95, cross_validate, loo_predictions
+from colonsim.surrogate.gp import GaussianProcess
+from colonsim.surrogate.likelihood import log_marginal_likelihood
+from colonsim.surrogate.validation import Z95, cross_validate, loo_predictions
 
 
 def smooth(X):

@@ -1,6 +1,6 @@
 """The surrogate of a sweep table: domains, targets, files, presets and scope ranking.
 
-Tables are SYNTHETIC (surrogate.synthetic: a known smooth function plus noise): these tests
+Tables are SYNTHETIC (colonsim.surrogate.synthetic: a known smooth function plus noise): these tests
 check the regression machinery, not physics.
 """
 
@@ -13,12 +13,12 @@ import pandas as pd
 import pytest
 
 from colonsim.errors import ColonsimError
-from surrogate import OutOfDomainWarning, SweepSurrogate
-from surrogate.patients import PatientPresets, patient_inputs
-from surrogate.recommend import recommend
-from surrogate.store import load_surrogate, save_surrogate
-from surrogate.synthetic import synthetic_deformation, synthetic_sweep
-from surrogate.table import NAMED_SCOPES_MM
+from colonsim.surrogate import OutOfDomainWarning, SweepSurrogate
+from colonsim.surrogate.patients import PatientPresets, patient_inputs
+from colonsim.surrogate.recommend import recommend
+from colonsim.surrogate.store import load_surrogate, save_surrogate
+from colonsim.surrogate.synthetic import synthetic_deformation, synthetic_sweep
+from colonsim.surrogate.table import NAMED_SCOPES_MM
 
 TARGETS = ("final_deformation_cm", "point_A_cm", "peak_contact_force_N")
 
@@ -53,7 +53,7 @@ def test_undefined_targets_have_no_model_and_say_why(model):
 
 
 def test_named_scopes_agree_with_the_solver():
-    from insertion.scopes import NAMED_SCOPES
+    from colonsim.insertion.anatomy.scopes import NAMED_SCOPES
 
     assert NAMED_SCOPES_MM == {k: round(v[1] * 1e3, 6) for k, v in NAMED_SCOPES.items()}
 

@@ -15,9 +15,9 @@ from pathlib import Path
 import pandas as pd
 import pytest
 
-from insertion.scenario import InsertionCase, run_insertion
-from insertion.sweep import DIED, IDENTITY, OUTPUTS, TABLE, SweepStore, result_row, run_sweep
-from insertion.sweep_spec import load_sweep
+from colonsim.insertion.case.scenario import InsertionCase, run_insertion
+from colonsim.insertion.study.sweep import DIED, IDENTITY, OUTPUTS, TABLE, SweepStore, result_row, run_sweep
+from colonsim.insertion.study.sweep_spec import load_sweep
 
 ROOT = Path(__file__).resolve().parents[1]
 SMOKE = load_sweep(preset="smoke").cases
@@ -48,7 +48,7 @@ def check_ok_rows(folder, table):
 
 
 def _task_threads():
-    from insertion import sweep_worker
+    from colonsim.insertion.study import sweep_worker
 
     sweep_worker._one_thread()
     return __import__("numba").get_num_threads()
@@ -184,7 +184,7 @@ def test_a_folder_holds_one_sweep(tmp_path):
     """Resuming the same sweep is allowed (same cases, or the same TOML text after the case fields
     changed); another sweep is refused, also into a folder without sweep.json."""
     from colonsim.errors import ColonsimError
-    from insertion.sweep_spec import parse_sweep
+    from colonsim.insertion.study.sweep_spec import parse_sweep
 
     a = parse_sweep('[sweep]\nname = "a"\n[[grid]]\nsegment = "straight"\nscope = ["utc", "sdc"]\n')
     b = parse_sweep('[sweep]\nname = "b"\n[[grid]]\nsegment = "straight"\nscope = ["pdc"]\n')
@@ -208,7 +208,7 @@ def test_an_unreachable_scheduler_fails_before_anything_is_written(tmp_path):
     import socket
 
     from colonsim.errors import ColonsimError
-    from insertion.sweep_spec import parse_sweep
+    from colonsim.insertion.study.sweep_spec import parse_sweep
 
     with socket.socket() as s:  # a loopback port nobody listens on
         s.bind(("127.0.0.1", 0))

@@ -10,9 +10,9 @@ import pytest
 
 from colonsim.cli import main
 from colonsim.errors import ColonsimError
-from insertion.material import REFERENCE_MATERIAL_PATH
-from insertion.scenario import InsertionCase
-from insertion.sweep_spec import PRESETS, latin_hypercube, load_sweep, parse_sweep
+from colonsim.insertion.engine.material import REFERENCE_MATERIAL_PATH
+from colonsim.insertion.case.scenario import InsertionCase
+from colonsim.insertion.study.sweep_spec import PRESETS, latin_hypercube, load_sweep, parse_sweep
 
 
 def test_thesis_preset_holds_every_case_of_chapter_v():

@@ -13,9 +13,9 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from colonsim.errors import ColonsimError
-from insertion.scenario import SEGMENTS, InsertionCase
-from insertion.scopes import colonoscope
-from insertion.sweep_spec import SCOPE_DIAMETER, parse_sweep
+from colonsim.insertion.case.scenario import SEGMENTS, InsertionCase
+from colonsim.insertion.anatomy.scopes import colonoscope
+from colonsim.insertion.study.sweep_spec import SCOPE_DIAMETER, parse_sweep
 
 DEFAULTS = {f.name: f.default for f in dataclasses.fields(InsertionCase)}
 TEXT = st.text(st.characters(blacklist_categories=("Cs",)), max_size=6)  # TOML text cannot hold lone surrogates

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from colonsim.errors import ColonsimError
-from identification.testdata import TensileCurve, mean_curve, read_curve, read_manifest, write_curve
+from colonsim.identification.testdata import TensileCurve, mean_curve, read_curve, read_manifest, write_curve
 
 GEOM = dict(length=0.1, width=0.025, thickness=0.002)
 GOOD = "displacement [mm],force [N]\n0.5,0.10\n1.0,0.21\n1.5,0.33\n2.0,0.46\n"

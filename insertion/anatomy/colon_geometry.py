@@ -1,4 +1,4 @@
-"""Triangle mesh of a tube of constant diameter around a :class:`insertion.centerline.Centerline`.
+"""Triangle mesh of a tube of constant diameter around a :class:`colonsim.insertion.anatomy.centerline.Centerline`.
 
 Rings of ``m = round(pi D / h)`` nodes sit every ``~h sqrt(3)/2`` of arc length, every other ring
 rotated by half a node spacing, so the triangles are close to equilateral with edges of about h
@@ -18,8 +18,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from colonsim.errors import ColonsimError
-from insertion.centerline import Centerline
-from insertion.sheet_mesh import orient_outward, ring_triangles
+from colonsim.insertion.anatomy.centerline import Centerline
+from colonsim.insertion.engine.sheet_mesh import orient_outward, ring_triangles
 
 MAX_NODES = 2_000_000  # beyond this the explicit solver would run for days: an element size typo
 

@@ -12,8 +12,9 @@ import warnings
 from dataclasses import dataclass
 from pathlib import Path
 
+from colonsim.data import REFERENCE_MATERIAL_PATH
 from colonsim.errors import ColonsimError, ColonsimWarning
-from identification.laws import get_law
+from colonsim.identification.laws import get_law
 
 LAW = "mooney_rivlin_3"
 PARAMETER_NAMES = ("C10", "C01", "C11")
@@ -37,27 +38,6 @@ def solver_law_gap(law):
         return None
     return (f"the insertion solver's wall law is {LAW}; {law} is not a special case of it (the solver runs "
             f"{', '.join(SOLVER_LAWS)})")
-
-
-def _reference_material_path():
-    """Locate ``data/material_reference.json``: beside the package in a source tree, else as
-    installed package data; never raise at import time."""
-    path = Path(__file__).resolve().parents[1] / "data" / "material_reference.json"
-    if path.is_file():
-        return path
-    try:
-        from importlib import resources
-
-        candidate = resources.files("colonsim") / "data" / "material_reference.json"
-        if candidate.is_file():
-            return Path(str(candidate))
-    except Exception:  # noqa: BLE001 - any packaging failure just means "not installed as data"
-        pass
-    # Keep the source-tree path: load_material then names it in a clear "not found" error.
-    return path
-
-
-REFERENCE_MATERIAL_PATH = _reference_material_path()
 
 
 @dataclass(frozen=True)

@@ -37,10 +37,10 @@ import pandas as pd
 from colonsim.errors import ColonsimError
 from colonsim.files import atomic_path, check_output_folder, write_json
 from colonsim.provenance import code_version
-from insertion.run_budget import DEFAULT_MAX_STEPS, check_sweep_budget
-from insertion.scenario import InsertionCase, InsertionResult
-from insertion.scopes import colonoscope
-from insertion.sweep_worker import execute, start_worker
+from colonsim.insertion.case.run_budget import DEFAULT_MAX_STEPS, check_sweep_budget
+from colonsim.insertion.case.scenario import InsertionCase, InsertionResult
+from colonsim.insertion.anatomy.scopes import colonoscope
+from colonsim.insertion.study.sweep_worker import execute, start_worker
 
 TABLE = "results.parquet"
 SWEEP_DOCUMENT = "sweep.json"
@@ -80,7 +80,7 @@ def _outputs(summary) -> dict:
     for p in "ABC":
         out[f"point_{p}_cm"] = number((points.get(p) or {}).get("deformation_cm"))
     qs = summary.get("quasi_static") or {}
-    # KE/IE < 10 % for both bodies, the scope's imposed sliding set aside (insertion.outcomes)
+    # KE/IE < 10 % for both bodies, the scope's imposed sliding set aside (colonsim.insertion.case.outcomes)
     out["quasi_static"] = bool(qs.get("holds", False))
     out["quasi_static_literal"] = bool((qs.get("literal") or {}).get("holds", False))
     end = summary.get("end") or {}
@@ -92,7 +92,7 @@ def _outputs(summary) -> dict:
 
 
 def result_row(case, outcome, timeseries_path="") -> dict:
-    """The table row of one run (``outcome`` from :func:`insertion.sweep_worker.execute`)."""
+    """The table row of one run (``outcome`` from :func:`colonsim.insertion.study.sweep_worker.execute`)."""
     ok = outcome["status"] == "ok"
     return {"key": case.key(), "status": outcome["status"], "error": outcome.get("error", ""),
             "wall_time_s": float(outcome["wall_time_s"]), "timeseries_path": timeseries_path if ok else "",
@@ -199,7 +199,7 @@ class SweepStore:
         """Write the run folder (ok runs), then the table with the run's row; return the row."""
         path = ""
         if outcome["status"] == "ok":
-            from insertion.results import write_insertion
+            from colonsim.insertion.case.results import write_insertion
 
             folder = Path("runs") / case.key()
             result = InsertionResult(case, outcome["timeseries"], outcome["summary"], snapshots=[], model=None,
@@ -356,7 +356,7 @@ def run_sweep(cases, out, workers=2, scheduler=None, runner=None, retry_failed=F
     Parameters
     ----------
     cases : list of InsertionCase
-        Validated cases (:func:`insertion.sweep_spec.load_sweep`).
+        Validated cases (:func:`colonsim.insertion.study.sweep_spec.load_sweep`).
     out : path
         The sweep folder (created; reused to resume).
     workers : int
@@ -364,7 +364,7 @@ def run_sweep(cases, out, workers=2, scheduler=None, runner=None, retry_failed=F
     scheduler : str or None
         Address of a Dask distributed scheduler, e.g. ``tcp://10.0.0.5:8786``.
     runner : callable(case) -> result, or None
-        The simulation (default :func:`insertion.scenario.run_insertion`); must be importable
+        The simulation (default :func:`colonsim.insertion.case.scenario.run_insertion`); must be importable
         by the workers.
     retry_failed : bool
         Run again the cases recorded as failed.
@@ -372,7 +372,7 @@ def run_sweep(cases, out, workers=2, scheduler=None, runner=None, retry_failed=F
         Written to ``sweep.json``: it names the sweep the folder holds.
     max_steps : int
         Refuse the sweep if a run of one of its materials needs more time steps
-        (:func:`insertion.run_budget.check_sweep_budget`).
+        (:func:`colonsim.insertion.case.run_budget.check_sweep_budget`).
     """
     if workers < 1:
         raise ColonsimError(f"workers = {workers}; give at least 1 worker process")

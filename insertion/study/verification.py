@@ -16,13 +16,13 @@ import numpy as np
 from scipy.optimize import brentq
 from scipy.special import ellipk
 
-from insertion.contact import RodShellContact
-from insertion.material import REFERENCE_MATERIAL_PATH, load_material
-from insertion.rod import Rod
-from insertion.sheet_mesh import flat_sheet, straight_tube
-from insertion.shell import Shell, dihedral_angles
-from insertion.solver import ExplicitSolver, FixedNodes, LineConstraint, NodalLoad, PrescribedVelocity
-from insertion.statics import minimize_energy
+from colonsim.insertion.engine.contact import RodShellContact
+from colonsim.insertion.engine.material import REFERENCE_MATERIAL_PATH, load_material
+from colonsim.insertion.engine.rod import Rod
+from colonsim.insertion.engine.sheet_mesh import flat_sheet, straight_tube
+from colonsim.insertion.engine.shell import Shell, dihedral_angles
+from colonsim.insertion.engine.solver import ExplicitSolver, FixedNodes, LineConstraint, NodalLoad, PrescribedVelocity
+from colonsim.insertion.engine.statics import minimize_energy
 
 # The standard scope (catalogue diameter).
 SCOPE_E = 16e6  # Pa

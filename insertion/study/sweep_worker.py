@@ -32,7 +32,7 @@ def _one_thread():
 
 def warm_up_case():
     """A tiny insertion (coarse straight tube, fast push) that touches every kernel once."""
-    from insertion.scenario import InsertionCase
+    from colonsim.insertion.case.scenario import InsertionCase
 
     return InsertionCase(segment="straight", scope="pdc", element_size_mm=12.0, scope_spacing_mm=20.0,
                          push_speed=5.0, ramp_s=0.01, record_interval_s=0.01)
@@ -54,7 +54,7 @@ def prepare_worker():
     with _RUN_LOCK:
         if _PREPARED:
             return
-        from insertion.scenario import run_insertion
+        from colonsim.insertion.case.scenario import run_insertion
 
         run_insertion(warm_up_case())
         _PREPARED = True
@@ -91,7 +91,7 @@ def start_worker():
 
 
 def default_runner(case):
-    from insertion.scenario import run_insertion
+    from colonsim.insertion.case.scenario import run_insertion
 
     return run_insertion(case)
 
@@ -103,7 +103,7 @@ def execute(case, runner=None) -> dict:
     ----------
     case : InsertionCase
     runner : callable(case) -> result with ``.summary`` and ``.timeseries``, or None
-        The simulation (default :func:`insertion.scenario.run_insertion`); tests inject failures here.
+        The simulation (default :func:`colonsim.insertion.case.scenario.run_insertion`); tests inject failures here.
 
     Returns
     -------

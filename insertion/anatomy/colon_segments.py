@@ -1,7 +1,7 @@
 """The colon models of the study as simulation-ready geometry (docs/model.md, "Colon models").
 
-A thin layer over :mod:`insertion.centerline` (the centerlines, their fixed/mobile tags and their
-readings, in the builders' docstrings) and :mod:`insertion.colon_geometry` (the tube mesh). It
+A thin layer over :mod:`colonsim.insertion.anatomy.centerline` (the centerlines, their fixed/mobile tags and their
+readings, in the builders' docstrings) and :mod:`colonsim.insertion.anatomy.colon_geometry` (the tube mesh). It
 adds what an insertion run needs from a model (**assumptions** where marked):
 
 - the wall is meshed at its mid-surface, diameter D + t, because contact acts half a thickness
@@ -11,7 +11,7 @@ adds what an insertion run needs from a model (**assumptions** where marked):
 - RSJ: the run ends when the tip is ``PAST_JUNCTION`` (2 cm) past the sigmoid's junction with
   the fixed exit;
 - RSF: the sigmoid tilts by alpha towards the patient's left, away from the side the splenic
-  flexure turns to (:func:`insertion.centerline.rsf_centerline`); alpha = 0 is one straight line;
+  flexure turns to (:func:`colonsim.insertion.anatomy.centerline.rsf_centerline`); alpha = 0 is one straight line;
 - THF / fixed THF: the scope enters the transverse colon directly;
 - RSF, THF: straightening ends where the mobile part ends (``straighten_depth``); while
   straightening, each mobile node may only move along the straight piece it belongs to
@@ -30,10 +30,10 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from colonsim.errors import ColonsimError
-from insertion.centerline import (EXIT_LENGTH, FLEXURE_ANGLE_DEG, Straight, rsf_centerline, rsj_centerline,
+from colonsim.insertion.anatomy.centerline import (EXIT_LENGTH, FLEXURE_ANGLE_DEG, Straight, rsf_centerline, rsj_centerline,
                                   thf_centerline, thf_fixed_centerline)
-from insertion.colon_geometry import tube_mesh
-from insertion.sheet_mesh import straight_tube
+from colonsim.insertion.anatomy.colon_geometry import tube_mesh
+from colonsim.insertion.engine.sheet_mesh import straight_tube
 
 ANGLE_LIMIT_DEG = 60.0  # RSF alpha and THF beta; the source used 0, 30, 45
 EXIT_LIMIT = 0.3  # m, fixed exit piece

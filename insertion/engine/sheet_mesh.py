@@ -2,7 +2,7 @@
 
 Both meshes use rows (rings) of nodes offset by half a step from one row to the next, so the
 triangles are close to equilateral. That matters beyond looks: the discrete hinge bending energy
-of :mod:`insertion.shell` is calibrated on near-equilateral meshes (on right-triangle meshes it
+of :mod:`colonsim.insertion.engine.shell` is calibrated on near-equilateral meshes (on right-triangle meshes it
 converges to a different, direction-dependent stiffness).
 """
 

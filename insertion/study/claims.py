@@ -1,6 +1,6 @@
 """The source's claims (docs/model.md, "Reference results") evaluated on a sweep results table.
 
-Each function takes the table of :mod:`insertion.sweep` (one row per run: ``segment``, ``scope``,
+Each function takes the table of :mod:`colonsim.insertion.study.sweep` (one row per run: ``segment``, ``scope``,
 ``diameter_mm``, ``friction``, ``angle_deg``, ``point_A_cm``, ``point_C_cm``,
 ``final_deformation_cm``, ``status``) and returns a :class:`ClaimResult` whose verdict is
 
@@ -10,7 +10,7 @@ Each function takes the table of :mod:`insertion.sweep` (one row per run: ``segm
   nothing is guessed from the runs that are there.
 
 A run's scope is UTC, PDC or SDC by name, or by its ``scope_diameter_mm`` when that is a
-catalogue or a source-mesh diameter (:func:`insertion.scopes.scope_role`), so the source's
+catalogue or a source-mesh diameter (:func:`colonsim.insertion.anatomy.scopes.scope_role`), so the source's
 meshed scopes (9.2 / 11.1 / 13.3 mm) count as its UTC / PDC / SDC.
 
 The criterion of each claim is stated in ``ClaimResult.criterion``; the thresholds that make a
@@ -25,7 +25,7 @@ import numpy as np
 import pandas as pd
 
 from colonsim.errors import ColonsimError
-from insertion.scopes import scope_role
+from colonsim.insertion.anatomy.scopes import scope_role
 
 REPRODUCED = "REPRODUCED"
 NOT_REPRODUCED = "NOT REPRODUCED"

@@ -6,7 +6,7 @@ tip_arc_m (tip position along the centerline, the closest centerline point), tip
 (signed distance of the tip past the end plane of the run: >= 0 once it has passed the fixed end), contact_force_N (sum of normal contact forces),
 push_force_N (drive reaction along the sheath axis), contact_nodes, kinetic/internal energy
 of each body (J), kinetic_scope_sliding_J (the scope's kinetic energy relative to sliding along
-itself at the push speed, :func:`insertion.outcomes.sliding_kinetic_energy`), contact_energy_J, dt_s, step.
+itself at the push speed, :func:`colonsim.insertion.case.outcomes.sliding_kinetic_energy`), contact_energy_J, dt_s, step.
 """
 
 from __future__ import annotations
@@ -14,7 +14,7 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from insertion.outcomes import JAM_PUSH, jammed, principal_stretches, sliding_kinetic_energy
+from colonsim.insertion.case.outcomes import JAM_PUSH, jammed, principal_stretches, sliding_kinetic_energy
 
 
 class InsertionRecorder:
@@ -75,7 +75,7 @@ class InsertionRecorder:
             self._next_snapshot += self.snapshot_interval
 
     def jammed(self) -> bool:
-        """Has the tip jammed at the last sample (:func:`insertion.outcomes.jammed`)?"""
+        """Has the tip jammed at the last sample (:func:`colonsim.insertion.case.outcomes.jammed`)?"""
         if not self.rows:
             return False
         depth = self.rows[-1]["depth_m"]

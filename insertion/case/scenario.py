@@ -3,7 +3,7 @@
 :class:`InsertionCase` holds every input with the model's default (mm, degrees and m/s are the
 user's units; SI inside). :func:`build_insertion` turns it into bodies, contact, constraints and
 a push profile; :func:`run_insertion` integrates and records the outputs through
-:class:`insertion.recording.InsertionRecorder`.
+:class:`colonsim.insertion.case.recording.InsertionRecorder`.
 
 Modelling choices (stated so they can be cited):
 - the scope starts straight inside a rigid sheath on the extension of the colon entry axis, its
@@ -21,7 +21,7 @@ Modelling choices (stated so they can be cited):
   (``"tip_past_end"``: for RSJ 2 cm past the sigmoid's fixed end; ``"far_end"``: for RSF/THF the
   far end of the fixed exit, beyond which the tip would leave the model), when the available
   length is pushed in (``"length_used"``), or when the tip jams (``"jam"``,
-  :func:`insertion.outcomes.jammed`). A jam is an outcome: the summary says where and under which
+  :func:`colonsim.insertion.case.outcomes.jammed`). A jam is an outcome: the summary says where and under which
   forces.
 """
 
@@ -37,15 +37,15 @@ import numpy as np
 
 from colonsim.errors import ColonsimError
 from colonsim.provenance import code_version
-from insertion.colon_segments import colon_geometry
-from insertion.contact import RodShellContact
-from insertion.manoeuvre import PushProfile, continuous_push, straighten_relax_push
-from insertion.material import REFERENCE_MATERIAL_PATH, load_material
-from insertion.outcomes import JAM_PROGRESS, JAM_PUSH, characteristic_points, quasi_static_fraction
-from insertion.recording import InsertionRecorder
-from insertion.scopes import colonoscope
-from insertion.shell import Shell
-from insertion.solver import ExplicitSolver, FixedNodes, LineConstraint, PrescribedVelocity
+from colonsim.insertion.anatomy.colon_segments import colon_geometry
+from colonsim.insertion.engine.contact import RodShellContact
+from colonsim.insertion.anatomy.manoeuvre import PushProfile, continuous_push, straighten_relax_push
+from colonsim.insertion.engine.material import REFERENCE_MATERIAL_PATH, load_material
+from colonsim.insertion.case.outcomes import JAM_PROGRESS, JAM_PUSH, characteristic_points, quasi_static_fraction
+from colonsim.insertion.case.recording import InsertionRecorder
+from colonsim.insertion.anatomy.scopes import colonoscope
+from colonsim.insertion.engine.shell import Shell
+from colonsim.insertion.engine.solver import ExplicitSolver, FixedNodes, LineConstraint, PrescribedVelocity
 
 SEGMENTS = ("rsj", "rsf", "thf", "thf-fixed", "straight")
 # the source's scope lengths; "straight" is the sanity case (a 20 cm straight tube), not one of its models.

@@ -13,7 +13,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from colonsim.errors import ColonsimError
-from insertion.rod import Rod
+from colonsim.insertion.engine.rod import Rod
 
 SCOPE_YOUNGS_MODULUS = 16e6  # Pa
 SCOPE_DENSITY = 2944.0  # kg/m^3
@@ -71,7 +71,7 @@ class Colonoscope:
             )
 
     def rod(self, start, direction, length, spacing=5e-3):
-        """The scope as a straight :class:`insertion.rod.Rod` from ``start`` (proximal end)."""
+        """The scope as a straight :class:`colonsim.insertion.engine.rod.Rod` from ``start`` (proximal end)."""
         return Rod.straight(length, self.diameter, self.youngs_modulus, self.density, spacing=spacing,
                             start=start, direction=direction, name=f"scope {self.name}")
 

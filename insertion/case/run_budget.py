@@ -3,7 +3,7 @@
 An explicit solver takes steps no longer than the stable step of its stiffest, lightest part. A
 wall material in the wrong unit (MPa written as Pa: 1e6 times too stiff) shrinks the step by
 sqrt(1e6) = 1000, and a run of seconds becomes one of hours that looks like a hang.
-:func:`estimate_run` builds the model (``insertion.scenario.build_insertion``, ~0.1-0.5 s), reads
+:func:`estimate_run` builds the model (``colonsim.insertion.case.scenario.build_insertion``, ~0.1-0.5 s), reads
 the solver's stable time step at the start and the push duration, and estimates the steps and
 the wall time; :func:`check_run_budget` refuses a run over a step limit, naming the likely cause.
 
@@ -54,7 +54,7 @@ class RunBudget:
 
     def likely_causes(self) -> list:
         """What in the case makes the run long, compared with the defaults (most likely first)."""
-        from insertion.scenario import InsertionCase
+        from colonsim.insertion.case.scenario import InsertionCase
 
         default, case, causes = InsertionCase(), self.case, []
         ratio = self.wall_mu0_Pa / self.reference_mu0_Pa
@@ -78,8 +78,8 @@ class RunBudget:
 
 def estimate_run(case) -> RunBudget:
     """Build ``case``'s model and estimate its time step, steps and wall time (see module docstring)."""
-    from insertion.material import REFERENCE_MATERIAL_PATH, load_material
-    from insertion.scenario import build_insertion
+    from colonsim.insertion.engine.material import REFERENCE_MATERIAL_PATH, load_material
+    from colonsim.insertion.case.scenario import build_insertion
 
     model = build_insertion(case)
     solver = model.solver

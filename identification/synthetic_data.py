@@ -1,4 +1,4 @@
-"""Generate the bundled SYNTHETIC tensile data set (docs/model.md). Rerun: python data/generate_synthetic.py
+"""Generate the bundled SYNTHETIC tensile data set (docs/model.md). Rerun: python -m colonsim.identification.synthetic_data
 
 No public colon tensile data set exists, so the bundled curves are made here:
 - 8 specimens whose Mooney-Rivlin parameters scatter (log-normal, 15 % sd) around the source's
@@ -20,15 +20,15 @@ RMS deviation of the mean curve) goes to tensile/ground_truth.json beside the da
 from __future__ import annotations
 
 import json
-from pathlib import Path
 
 import numpy as np
 from scipy.interpolate import CubicSpline
 
-from identification.specimen import ClampedStripModel
-from identification.testdata import TensileCurve, write_curve
+from colonsim.data import data_path
+from colonsim.identification.specimen import ClampedStripModel
+from colonsim.identification.testdata import TensileCurve, write_curve
 
-HERE = Path(__file__).resolve().parent
+HERE = data_path()
 OUT = HERE / "tensile"
 SEED = 20181
 N_SPECIMENS = 8
@@ -68,7 +68,7 @@ def main():
         f = np.round(clean(d) + NOISE_SD * rng.standard_normal(d.size), 3)
         curve = TensileCurve(name, d, f, LENGTH, WIDTH, thickness)
         write_curve(OUT / f"{name}.csv", curve,
-                    comment=f"SYNTHETIC colon strip tensile test (colonsim data/generate_synthetic.py), {name}")
+                    comment=f"SYNTHETIC colon strip tensile test (colonsim.identification.synthetic_data), {name}")
         manifest.append(f"{name},{name}.csv,{LENGTH * 1e3:.1f},{WIDTH * 1e3:.1f},{thickness * 1e3:.4f}")
         truth["specimens"][name] = {"parameters_Pa": params, "thickness_mm": thickness * 1e3}
         noisy_on_grid.append(np.interp(mean_grid, d, f))
@@ -81,7 +81,7 @@ def main():
     mean_t = float(np.mean(thicknesses))
     mean_curve = TensileCurve("mean_curve", mean_grid, mean_force, LENGTH, WIDTH, mean_t)
     write_curve(OUT / "mean_curve.csv", mean_curve,
-                comment="SYNTHETIC mean of the 8 specimen curves on a 0.25 mm grid (colonsim data/generate_synthetic.py)")
+                comment="SYNTHETIC mean of the 8 specimen curves on a 0.25 mm grid (colonsim.identification.synthetic_data)")
     (OUT / "manifest.csv").write_text("\n".join(manifest) + "\n")
     (OUT / "manifest_mean.csv").write_text(
         "specimen,file,length_mm,width_mm,thickness_mm\n"

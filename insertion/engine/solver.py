@@ -20,12 +20,12 @@ the time, the step and the remedy.
 Example (run by the test suite)::
 
     import numpy as np
-    from insertion.contact import RodShellContact
-    from insertion.material import REFERENCE_MATERIAL_PATH, load_material
-    from insertion.rod import Rod
-    from insertion.sheet_mesh import straight_tube
-    from insertion.shell import Shell
-    from insertion.solver import ExplicitSolver, FixedNodes, LineConstraint, PrescribedVelocity
+    from colonsim.insertion.engine.contact import RodShellContact
+    from colonsim.insertion.engine.material import REFERENCE_MATERIAL_PATH, load_material
+    from colonsim.insertion.engine.rod import Rod
+    from colonsim.insertion.engine.sheet_mesh import straight_tube
+    from colonsim.insertion.engine.shell import Shell
+    from colonsim.insertion.engine.solver import ExplicitSolver, FixedNodes, LineConstraint, PrescribedVelocity
 
     nodes, tri, ring = straight_tube(0.1, 0.038, 6e-3)  # mid-surface diameter = lumen + wall
     colon = Shell(nodes, tri, 2e-3, load_material(REFERENCE_MATERIAL_PATH), name="colon")
@@ -424,7 +424,7 @@ class ExplicitSolver:
     bodies : list of body objects
         Each with ``name``, ``x0``, ``mass``, ``internal_forces(x, f)``, ``critical_time_step(x)``.
     contacts : list
-        Contact objects (:class:`insertion.contact.RodShellContact`).
+        Contact objects (:class:`colonsim.insertion.engine.contact.RodShellContact`).
     constraints : list
         :class:`FixedNodes`, :class:`PrescribedVelocity`, :class:`LineConstraint`.
     loads : list

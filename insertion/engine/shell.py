@@ -20,7 +20,7 @@ exactly; spherical bending is 2.25 times too soft and saddle bending 2.7 times t
 Tests: tests/test_shell_bending.py.
 
 All kernels are ``numba`` functions over raw arrays writing per-element buffers that
-:func:`insertion._scatter.gather` sums onto nodes without races.
+:func:`colonsim.insertion.engine._scatter.gather` sums onto nodes without races.
 """
 
 import math
@@ -29,8 +29,8 @@ import numba
 import numpy as np
 
 from colonsim.errors import ColonsimError
-from insertion._scatter import gather, node_incidence
-from insertion.sheet_mesh import hinges as mesh_hinges
+from colonsim.insertion.engine._scatter import gather, node_incidence
+from colonsim.insertion.engine.sheet_mesh import hinges as mesh_hinges
 
 # ---------------------------------------------------------------------------------------------
 # Reference geometry
@@ -651,7 +651,7 @@ class Shell:
         Consistently oriented triangles; for a tube, normals out of the lumen.
     thickness : float
         Reference wall thickness, m.
-    material : insertion.material.MooneyRivlin
+    material : colonsim.insertion.engine.material.MooneyRivlin
     density : float
         Wall density, kg/m^3.
     name : str

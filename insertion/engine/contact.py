@@ -327,8 +327,8 @@ class RodShellContact:
 
     Parameters
     ----------
-    rod : insertion.rod.Rod
-    shell : insertion.shell.Shell
+    rod : colonsim.insertion.engine.rod.Rod
+    shell : colonsim.insertion.engine.shell.Shell
     stiffness : float or None
         Penalty stiffness per free wall node, N/m. None: chosen so that the lightest wall node on
         its contact spring oscillates at half the shell's highest frequency (with the default

@@ -1,7 +1,7 @@
 """What a sweep runs: a TOML description (or a preset) expanded into validated insertion cases.
 
 Format (every key of ``[fixed]``, ``[[grid]]`` and ``[lhs]`` is a field of
-:class:`insertion.scenario.InsertionCase`, in its user units, or ``scope_diameter_mm``)::
+:class:`colonsim.insertion.case.scenario.InsertionCase`, in its user units, or ``scope_diameter_mm``)::
 
     [sweep]
     name = "rsj-scopes"          # names the default output folder
@@ -62,7 +62,7 @@ from pathlib import Path
 import numpy as np
 
 from colonsim.errors import ColonsimError
-from insertion.scenario import InsertionCase
+from colonsim.insertion.case.scenario import InsertionCase
 
 if sys.version_info >= (3, 11):
     import tomllib
@@ -407,7 +407,7 @@ def _check_size(origin, grid_sizes, lhs):
     runs = max(grid, 1) * samples
     if runs <= MAX_RUNS:
         return
-    from insertion.run_budget import human_duration
+    from colonsim.insertion.case.run_budget import human_duration
 
     parts = [f"{grid:,} grid cases"] if grid else []
     parts += [f"{samples:,} hypercube samples"] if lhs is not None else []
@@ -418,7 +418,7 @@ def _check_size(origin, grid_sizes, lhs):
 
 
 def _check_materials(cases):
-    from insertion.material import load_material
+    from colonsim.insertion.engine.material import load_material
 
     for path in sorted({c.material for c in cases if c.material}):
         load_material(path)
