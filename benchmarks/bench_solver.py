@@ -26,7 +26,8 @@ from colonsim.insertion.engine.material import REFERENCE_MATERIAL_PATH, load_mat
 from colonsim.insertion.engine.rod import Rod
 from colonsim.insertion.engine.sheet_mesh import straight_tube
 from colonsim.insertion.engine.shell import Shell
-from colonsim.insertion.engine.solver import ExplicitSolver, FixedNodes, LineConstraint, NodalLoad, PrescribedVelocity
+from colonsim.insertion.engine.constraints import FixedNodes, LineConstraint, NodalLoad, PrescribedVelocity
+from colonsim.insertion.engine.solver import ExplicitSolver
 
 LUMEN = 0.036
 WALL = 2e-3

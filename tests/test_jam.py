@@ -6,7 +6,7 @@ import pytest
 import colonsim.insertion.case.scenario as scenario
 from colonsim.insertion.anatomy.colon_segments import straight_colon
 from colonsim.insertion.case.scenario import InsertionCase, run_insertion
-from colonsim.insertion.engine.solver import PrescribedVelocity
+from colonsim.insertion.engine.constraints import PrescribedVelocity
 
 STENOSIS_X = 0.10  # m along the straight tube
 STENOSIS_RADIUS = 2e-3  # m: a held iris far narrower than any scope

@@ -6,7 +6,8 @@ import numpy as np
 import pytest
 
 from colonsim.insertion.engine.rod import Rod
-from colonsim.insertion.engine.solver import ExplicitSolver, FixedNodes, LineConstraint, NodalLoad
+from colonsim.insertion.engine.constraints import FixedNodes, LineConstraint, NodalLoad
+from colonsim.insertion.engine.solver import ExplicitSolver
 
 E = 16e6
 RHO = 2944.0

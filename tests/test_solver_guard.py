@@ -5,7 +5,8 @@ import pytest
 
 from colonsim.errors import ColonsimError
 from colonsim.insertion.engine.rod import Rod
-from colonsim.insertion.engine.solver import ExplicitSolver, FixedNodes, PrescribedVelocity
+from colonsim.insertion.engine.constraints import FixedNodes, PrescribedVelocity
+from colonsim.insertion.engine.solver import ExplicitSolver
 
 E = 16e6
 RHO = 2944.0

@@ -45,7 +45,8 @@ from colonsim.insertion.case.outcomes import JAM_PROGRESS, JAM_PUSH, characteris
 from colonsim.insertion.case.recording import InsertionRecorder
 from colonsim.insertion.anatomy.scopes import colonoscope
 from colonsim.insertion.engine.shell import Shell
-from colonsim.insertion.engine.solver import ExplicitSolver, FixedNodes, LineConstraint, PrescribedVelocity
+from colonsim.insertion.engine.constraints import FixedNodes, LineConstraint, PrescribedVelocity
+from colonsim.insertion.engine.solver import ExplicitSolver
 
 SEGMENTS = ("rsj", "rsf", "thf", "thf-fixed", "straight")
 # the source's scope lengths; "straight" is the sanity case (a 20 cm straight tube), not one of its models.

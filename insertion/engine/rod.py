@@ -269,11 +269,6 @@ class Rod:
             )
         return energy
 
-    def axial_force(self, x):
-        """Axial force of each segment (n - 1,), N, positive in tension."""
-        length = np.linalg.norm(np.diff(x, axis=0), axis=1)
-        return self.axial_stiffness * (length - self.rest_length)
-
     def frequency_bound(self, x):
         """Gershgorin upper bound of the largest angular frequency at configuration x, rad/s.
 

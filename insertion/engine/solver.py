@@ -13,6 +13,9 @@ energy balance exact; kinetic energy is reported at the mid-velocity, internal (
 the body at x_n. Contact penalty energy and contact dissipation (damping and friction) are kept by
 the contact objects.
 
+Constraints and loads: :mod:`colonsim.insertion.engine.constraints`; nodal kernels:
+:mod:`colonsim.insertion.engine.integrator_kernels`.
+
 Divergence guard: a non-finite state, or mechanical energy growing beyond ``energy_growth_limit``
 times (initial energy + absolute work put in), stops the run with a :class:`ColonsimError` naming
 the time, the step and the remedy.
@@ -25,7 +28,8 @@ Example (run by the test suite)::
     from colonsim.insertion.engine.rod import Rod
     from colonsim.insertion.engine.sheet_mesh import straight_tube
     from colonsim.insertion.engine.shell import Shell
-    from colonsim.insertion.engine.solver import ExplicitSolver, FixedNodes, LineConstraint, PrescribedVelocity
+    from colonsim.insertion.engine.constraints import FixedNodes, LineConstraint, PrescribedVelocity
+    from colonsim.insertion.engine.solver import ExplicitSolver
 
     nodes, tri, ring = straight_tube(0.1, 0.038, 6e-3)  # mid-surface diameter = lumen + wall
     colon = Shell(nodes, tri, 2e-3, load_material(REFERENCE_MATERIAL_PATH), name="colon")
@@ -47,290 +51,11 @@ Example (run by the test suite)::
 
 import math
 
-import numba
 import numpy as np
 
 from colonsim.errors import ColonsimError
-
-# ---------------------------------------------------------------------------------------------
-# Kernels
-# ---------------------------------------------------------------------------------------------
-
-
-@numba.njit(cache=True, inline="always")  # a call per node would cost more than its work
-def _velocity_node(i, v, f_int, f_con, f_ext, mass, fixed, alpha, dt, v_new, f_damp, reaction):
-    # one division per node: divisions dominate this otherwise memory-bound loop
-    m = mass[i]
-    h = 0.5 * alpha * dt
-    keep = (1.0 - h) / (1.0 + h)
-    gain = dt / (m * (1.0 + h))
-    for k in range(3):
-        ftot = f_int[i, k] + f_con[i, k] + f_ext[i, k]
-        vf = keep * v[i, k] + gain * ftot
-        f_damp[i, k] = -0.5 * alpha * m * (v[i, k] + vf)
-        if fixed[i]:
-            v_new[i, k] = 0.0
-            reaction[i, k] = -vf * (m / dt)
-        else:
-            v_new[i, k] = vf
-            reaction[i, k] = 0.0
-
-
-@numba.njit(parallel=True, cache=True)
-def velocity_kernel(v, f_int, f_con, f_ext, mass, fixed, alpha, dt, v_new, f_damp, reaction):
-    """Damped velocity update into ``v_new``; fixed nodes get zero velocity and their reaction."""
-    for i in numba.prange(v.shape[0]):
-        _velocity_node(i, v, f_int, f_con, f_ext, mass, fixed, alpha, dt, v_new, f_damp, reaction)
-
-
-@numba.njit(cache=True)
-def velocity_kernel_serial(v, f_int, f_con, f_ext, mass, fixed, alpha, dt, v_new, f_damp, reaction):
-    """Serial :func:`velocity_kernel` for bodies too small to pay for threads."""
-    for i in range(v.shape[0]):
-        _velocity_node(i, v, f_int, f_con, f_ext, mass, fixed, alpha, dt, v_new, f_damp, reaction)
-
-
-@numba.njit(cache=True, inline="always")  # a call per node would cost more than its work
-def _advance_node(i, x, v, v_new, mass, f_int, f_con, f_ext, f_damp, reaction, dt):
-    w_int = 0.0
-    w_con = 0.0
-    w_ext = 0.0
-    w_damp = 0.0
-    w_react = 0.0
-    kinetic = 0.0
-    for k in range(3):
-        va = 0.5 * (v[i, k] + v_new[i, k])
-        w_int += f_int[i, k] * va
-        w_con += f_con[i, k] * va
-        w_ext += f_ext[i, k] * va
-        w_damp += f_damp[i, k] * va
-        w_react += reaction[i, k] * va
-        kinetic += 0.5 * mass[i] * va * va
-        x[i, k] += dt * v_new[i, k]
-        v[i, k] = v_new[i, k]
-    return w_int, w_con, w_ext, w_damp, w_react, kinetic
-
-
-@numba.njit(parallel=True, cache=True)
-def advance_kernel(x, v, v_new, mass, f_int, f_con, f_ext, f_damp, reaction, dt_mid, dt):
-    """Work increments of each force family, mid-step kinetic energy; then x += dt v_new, v = v_new.
-
-    Returns
-    -------
-    w_int, w_con, w_ext, w_damp, w_react, kinetic : float
-        Work (J) done on the body during the step by each family, and the kinetic energy at the
-        mid-step velocity (v_old + v_new) / 2.
-    """
-    w_int = 0.0
-    w_con = 0.0
-    w_ext = 0.0
-    w_damp = 0.0
-    w_react = 0.0
-    kinetic = 0.0
-    for i in numba.prange(x.shape[0]):
-        a, b, c, d, e, k = _advance_node(i, x, v, v_new, mass, f_int, f_con, f_ext, f_damp, reaction, dt)
-        w_int += a
-        w_con += b
-        w_ext += c
-        w_damp += d
-        w_react += e
-        kinetic += k
-    return w_int * dt_mid, w_con * dt_mid, w_ext * dt_mid, w_damp * dt_mid, w_react * dt_mid, kinetic
-
-
-@numba.njit(cache=True)
-def advance_kernel_serial(x, v, v_new, mass, f_int, f_con, f_ext, f_damp, reaction, dt_mid, dt):
-    """Serial :func:`advance_kernel` for bodies too small to pay for threads."""
-    w_int = 0.0
-    w_con = 0.0
-    w_ext = 0.0
-    w_damp = 0.0
-    w_react = 0.0
-    kinetic = 0.0
-    for i in range(x.shape[0]):
-        a, b, c, d, e, k = _advance_node(i, x, v, v_new, mass, f_int, f_con, f_ext, f_damp, reaction, dt)
-        w_int += a
-        w_con += b
-        w_ext += c
-        w_damp += d
-        w_react += e
-        kinetic += k
-    return w_int * dt_mid, w_con * dt_mid, w_ext * dt_mid, w_damp * dt_mid, w_react * dt_mid, kinetic
-
-
-@numba.njit(cache=True)
-def line_constraint_kernel(x, v_new, reaction, mass, nodes, point, direction, s_min, s_max, dt):
-    """Remove the velocity across the line on the listed nodes lying within [s_min, s_max] along
-    it; add the reaction impulse / dt. Returns the total reaction force (3,)."""
-    total = np.zeros(3)
-    for j in range(nodes.shape[0]):
-        i = nodes[j]
-        s = 0.0
-        for k in range(3):
-            s += (x[i, k] - point[k]) * direction[k]
-        if s < s_min or s > s_max:
-            continue
-        along = 0.0
-        for k in range(3):
-            along += v_new[i, k] * direction[k]
-        for k in range(3):
-            vc = along * direction[k]
-            r = mass[i] * (vc - v_new[i, k]) / dt
-            reaction[i, k] += r
-            total[k] += r
-            v_new[i, k] = vc
-    return total
-
-
-# ---------------------------------------------------------------------------------------------
-# Constraints and loads
-# ---------------------------------------------------------------------------------------------
-
-
-class _Windowed:
-    """Active on the time window [start, end).
-
-    ``reaction`` holds the total force (N) the constraint applied to its nodes during the last
-    step (for a pushed end: the push force). Fixed nodes are imposed first, then the other
-    constraints in the solver's list order, each on the velocities left by the previous ones.
-    """
-
-    def _init_window(self, body, nodes, start, end):
-        self.body = body
-        if nodes is None:
-            nodes = np.arange(len(body.x0))
-        self.nodes = np.unique(np.asarray(nodes, dtype=np.int64).ravel())
-        if len(self.nodes) and (self.nodes.min() < 0 or self.nodes.max() >= len(body.x0)):
-            raise ColonsimError(
-                f"constraint or load on body '{body.name}' names nodes that do not exist; fix the node list."
-            )
-        if not end > start:
-            raise ColonsimError(f"time window [{start}, {end}) is empty; give end > start.")
-        self.start = float(start)
-        self.end = float(end)
-        self.reaction = np.zeros(3)
-
-    def active(self, t):
-        return self.start <= t < self.end
-
-
-class FixedNodes(_Windowed):
-    """Nodes held at rest (zero velocity) while active.
-
-    Parameters
-    ----------
-    body : body object
-    nodes : int array
-    start, end : float
-        Time window in which the constraint acts, s ("birth and death").
-    """
-
-    def __init__(self, body, nodes, start=0.0, end=math.inf):
-        self._init_window(body, nodes, start, end)
-
-
-class PrescribedVelocity(_Windowed):
-    """Nodes moving with a prescribed velocity while active.
-
-    Parameters
-    ----------
-    body : body object
-    nodes : int array
-    velocity : (3,) array or callable t -> (3,) array
-        Velocity, m/s.
-    ramp : float
-        Duration of a smooth (1 - cos) start-up ramp from the window start, s (0 = step).
-    start, end : float
-        Time window, s.
-    """
-
-    def __init__(self, body, nodes, velocity, ramp=0.0, start=0.0, end=math.inf):
-        self._init_window(body, nodes, start, end)
-        self._velocity = velocity if callable(velocity) else np.asarray(velocity, dtype=np.float64).reshape(3)
-        if ramp < 0.0:
-            raise ColonsimError(f"ramp = {ramp} s must be >= 0; fix it.")
-        self.ramp = float(ramp)
-
-    def velocity(self, t):
-        """Prescribed velocity at time t, m/s."""
-        v = np.asarray(self._velocity(t) if callable(self._velocity) else self._velocity, dtype=np.float64)
-        tau = t - self.start
-        if self.ramp > 0.0 and tau < self.ramp:
-            v = v * 0.5 * (1.0 - math.cos(math.pi * max(tau, 0.0) / self.ramp))
-        return v
-
-    def apply(self, t_mid, v_new, reaction, mass, dt_mid):
-        vc = self.velocity(t_mid)
-        idx = self.nodes
-        r = mass[idx, None] * (vc[None, :] - v_new[idx]) / dt_mid
-        reaction[idx] += r
-        v_new[idx] = vc
-        return r.sum(axis=0)
-
-
-class LineConstraint(_Windowed):
-    """Nodes confined to a straight line (a rigid sheath) while they lie inside its extent.
-
-    A node is guided when its coordinate along the line, s = (x - point) . direction, lies in
-    [s_min, s_max]: its velocity component across the line is removed (motion along the line stays
-    free). Nodes started on the line stay on it.
-
-    Parameters
-    ----------
-    body : body object
-    point, direction : (3,) arrays
-        A point of the line and its direction.
-    extent : (s_min, s_max)
-        Guided stretch of the line, m.
-    nodes : int array or None
-        Candidate nodes (None = all nodes of the body).
-    start, end : float
-        Time window, s.
-    """
-
-    def __init__(self, body, point, direction, extent=(-math.inf, math.inf), nodes=None, start=0.0, end=math.inf):
-        self._init_window(body, nodes, start, end)
-        d = np.asarray(direction, dtype=np.float64).reshape(3)
-        if not np.linalg.norm(d) > 0.0:
-            raise ColonsimError("line constraint direction must be a non-zero vector; fix it.")
-        self.direction = d / np.linalg.norm(d)
-        self.point = np.asarray(point, dtype=np.float64).reshape(3)
-        self.extent = (float(extent[0]), float(extent[1]))
-
-    def apply(self, x, v_new, reaction, mass, dt_mid):
-        return line_constraint_kernel(x, v_new, reaction, mass, self.nodes, self.point, self.direction,
-                                      self.extent[0], self.extent[1], dt_mid)
-
-
-class NodalLoad(_Windowed):
-    """Applied nodal forces while active.
-
-    Parameters
-    ----------
-    body : body object
-    nodes : int array
-    force : (3,) array, (len(nodes), 3) array, or callable t -> one of those
-        Force per node, N.
-    start, end : float
-        Time window, s.
-    """
-
-    def __init__(self, body, nodes, force, start=0.0, end=math.inf):
-        nodes_arr = np.asarray(nodes, dtype=np.int64).ravel()
-        self._init_window(body, nodes, start, end)
-        if len(np.unique(nodes_arr)) != len(nodes_arr):
-            raise ColonsimError("a nodal load lists a node twice; give each node once.")
-        self.nodes = nodes_arr
-        self.force = force
-
-    def apply(self, t, f):
-        force = self.force(t) if callable(self.force) else self.force
-        f[self.nodes] += np.asarray(force, dtype=np.float64)
-
-
-# ---------------------------------------------------------------------------------------------
-# Solver
-# ---------------------------------------------------------------------------------------------
+from colonsim.insertion.engine.integrator_kernels import (advance_kernel, advance_kernel_serial, velocity_kernel,
+                                                          velocity_kernel_serial)
 
 
 class _BodyState:
@@ -426,9 +151,10 @@ class ExplicitSolver:
     contacts : list
         Contact objects (:class:`colonsim.insertion.engine.contact.RodShellContact`).
     constraints : list
-        :class:`FixedNodes`, :class:`PrescribedVelocity`, :class:`LineConstraint`.
+        :class:`~colonsim.insertion.engine.constraints.Constraint` objects (fixed nodes, prescribed
+        velocity, line).
     loads : list
-        :class:`NodalLoad`.
+        :class:`~colonsim.insertion.engine.constraints.NodalLoad` objects.
     damping : float or dict
         Mass-proportional damping coefficient alpha (1/s), one for all bodies or per body name.
         Critical damping of a mode of angular frequency w is alpha = 2 w.
@@ -538,7 +264,7 @@ class ExplicitSolver:
     # -- one step ---------------------------------------------------------------------------
 
     def _refresh_fixed(self, t):
-        active = tuple(isinstance(c, FixedNodes) and c.active(t) for c in self.constraints)
+        active = tuple(c.holds_at_rest and c.active(t) for c in self.constraints)
         if active == self._fixed_key:
             return
         self._fixed_key = active
@@ -576,7 +302,7 @@ class ExplicitSolver:
             raise self._diverged(str(err)) from err
         for load in self.loads:
             if load.active(t):
-                load.apply(t, self.state[load.body.name].f_ext)
+                load.add_forces(t, self.state[load.body.name].f_ext)
         self._refresh_fixed(t)
         for b in self.bodies:
             s = self.state[b.name]
@@ -585,16 +311,7 @@ class ExplicitSolver:
                    s.reaction)
         t_mid = t + 0.5 * dt
         for c in self.constraints:
-            if isinstance(c, FixedNodes):
-                c.reaction = self.state[c.body.name].reaction[c.nodes].sum(axis=0) if c.active(t) else np.zeros(3)
-                continue
-            s = self.state[c.body.name]
-            if not c.active(t):
-                c.reaction = np.zeros(3)
-            elif isinstance(c, PrescribedVelocity):
-                c.reaction = c.apply(t_mid, s.v_new, s.reaction, c.body.mass, dt_mid)
-            else:
-                c.reaction = c.apply(s.x, s.v_new, s.reaction, c.body.mass, dt_mid)
+            c.reaction = c.constrain_rates(t_mid, self.state[c.body.name], dt_mid) if c.active(t) else np.zeros(3)
         energy = 0.0
         work_in = 0.0
         for b in self.bodies:

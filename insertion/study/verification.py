@@ -21,7 +21,8 @@ from colonsim.insertion.engine.material import REFERENCE_MATERIAL_PATH, load_mat
 from colonsim.insertion.engine.rod import Rod
 from colonsim.insertion.engine.sheet_mesh import flat_sheet, straight_tube
 from colonsim.insertion.engine.shell import Shell, dihedral_angles
-from colonsim.insertion.engine.solver import ExplicitSolver, FixedNodes, LineConstraint, NodalLoad, PrescribedVelocity
+from colonsim.insertion.engine.constraints import FixedNodes, LineConstraint, NodalLoad, PrescribedVelocity
+from colonsim.insertion.engine.solver import ExplicitSolver
 from colonsim.insertion.engine.statics import minimize_energy
 
 # The standard scope (catalogue diameter).

@@ -1,0 +1,25 @@
+"""Compile one kernel source two ways: threaded and serial.
+
+Bodies and candidate lists below a size threshold run serially (starting threads costs more than
+their work, and much more on a loaded machine), larger ones on threads. Both variants come from
+one Python function. Numba keys its on-disk cache by module, qualified name and source line, not
+by compile options: the same function jitted with ``parallel=True`` and without shares one cache
+entry, and a process then loads the other variant's machine code (checked: the serial dispatcher
+reported a cache hit on the entry the threaded one wrote). The serial variant is therefore
+compiled from a copy of the function whose qualified name ends in ``_serial``: one source, two
+cache entries.
+"""
+
+import types
+
+import numba
+
+
+def threaded_and_serial(py_func):
+    """(threaded, serial) dispatchers of ``py_func``, a kernel whose main loop is ``numba.prange``
+    (a plain ``range`` when compiled serially), both cached."""
+    serial = types.FunctionType(py_func.__code__, py_func.__globals__, py_func.__name__ + "_serial",
+                                py_func.__defaults__, py_func.__closure__)
+    serial.__qualname__ = py_func.__qualname__ + "_serial"
+    serial.__doc__ = py_func.__doc__
+    return numba.njit(parallel=True, cache=True)(py_func), numba.njit(cache=True)(serial)

@@ -1,0 +1,201 @@
+"""Constraints and loads of the explicit solver.
+
+One contract (after PyElastica's constraint base, which has ``constrain_values`` and
+``constrain_rates``): the integrator updates positions from constrained velocities only
+(x_{n+1} = x_n + dt v_{n+1/2}), so a constraint acts on the rates. After the damped velocity
+update, every active constraint's :meth:`Constraint.constrain_rates` overwrites the
+velocities of its nodes, adds the reaction impulse / dt into the body's reaction buffer and
+returns the total reaction force (N). Fixed nodes are imposed first, inside the velocity update
+(:attr:`Constraint.holds_at_rest`), then the other constraints in the solver's list order, each
+on the velocities left by the previous ones. Loads add forces before the update.
+"""
+
+import math
+
+import numba
+import numpy as np
+
+from colonsim.errors import ColonsimError
+
+
+@numba.njit(cache=True)
+def line_constraint_kernel(x, v_new, reaction, mass, nodes, point, direction, s_min, s_max, dt):
+    """Remove the velocity across the line on the listed nodes lying within [s_min, s_max] along
+    it; add the reaction impulse / dt. Returns the total reaction force (3,)."""
+    total = np.zeros(3)
+    for j in range(nodes.shape[0]):
+        i = nodes[j]
+        s = 0.0
+        for k in range(3):
+            s += (x[i, k] - point[k]) * direction[k]
+        if s < s_min or s > s_max:
+            continue
+        along = 0.0
+        for k in range(3):
+            along += v_new[i, k] * direction[k]
+        for k in range(3):
+            vc = along * direction[k]
+            r = mass[i] * (vc - v_new[i, k]) / dt
+            reaction[i, k] += r
+            total[k] += r
+            v_new[i, k] = vc
+    return total
+
+
+class _Window:
+    """A node set of one body, active on the time window [start, end).
+
+    ``reaction`` holds the total force (N) the constraint applied to its nodes during the last
+    step (for a pushed end: the push force).
+    """
+
+    def _init_window(self, body, nodes, start, end):
+        self.body = body
+        if nodes is None:
+            nodes = np.arange(len(body.x0))
+        self.nodes = np.unique(np.asarray(nodes, dtype=np.int64).ravel())
+        if len(self.nodes) and (self.nodes.min() < 0 or self.nodes.max() >= len(body.x0)):
+            raise ColonsimError(
+                f"constraint or load on body '{body.name}' names nodes that do not exist; fix the node list."
+            )
+        if not end > start:
+            raise ColonsimError(f"time window [{start}, {end}) is empty; give end > start.")
+        self.start = float(start)
+        self.end = float(end)
+        self.reaction = np.zeros(3)
+
+    def active(self, t):
+        return self.start <= t < self.end
+
+
+class Constraint(_Window):
+    """Base of the constraints: see the module docstring for the contract."""
+
+    #: True for constraints the velocity update itself holds at rest (it also stores their reactions).
+    holds_at_rest = False
+
+    def constrain_rates(self, t_mid, state, dt_mid):
+        """Constrain ``state.v_new`` on the nodes, add the reactions into ``state.reaction``; return
+        the total reaction force (3,), N. ``t_mid``: mid-step time, s; ``dt_mid``: the step of
+        the staggered velocities, s."""
+        raise NotImplementedError
+
+
+class FixedNodes(Constraint):
+    """Nodes held at rest (zero velocity) while active.
+
+    Parameters
+    ----------
+    body : body object
+    nodes : int array
+    start, end : float
+        Time window in which the constraint acts, s ("birth and death").
+    """
+
+    holds_at_rest = True
+
+    def __init__(self, body, nodes, start=0.0, end=math.inf):
+        self._init_window(body, nodes, start, end)
+
+    def constrain_rates(self, t_mid, state, dt_mid):
+        return state.reaction[self.nodes].sum(axis=0)
+
+
+class PrescribedVelocity(Constraint):
+    """Nodes moving with a prescribed velocity while active.
+
+    Parameters
+    ----------
+    body : body object
+    nodes : int array
+    velocity : (3,) array or callable t -> (3,) array
+        Velocity, m/s.
+    ramp : float
+        Duration of a smooth (1 - cos) start-up ramp from the window start, s (0 = step).
+    start, end : float
+        Time window, s.
+    """
+
+    def __init__(self, body, nodes, velocity, ramp=0.0, start=0.0, end=math.inf):
+        self._init_window(body, nodes, start, end)
+        self._velocity = velocity if callable(velocity) else np.asarray(velocity, dtype=np.float64).reshape(3)
+        if ramp < 0.0:
+            raise ColonsimError(f"ramp = {ramp} s must be >= 0; fix it.")
+        self.ramp = float(ramp)
+
+    def velocity(self, t):
+        """Prescribed velocity at time t, m/s."""
+        v = np.asarray(self._velocity(t) if callable(self._velocity) else self._velocity, dtype=np.float64)
+        tau = t - self.start
+        if self.ramp > 0.0 and tau < self.ramp:
+            v = v * 0.5 * (1.0 - math.cos(math.pi * max(tau, 0.0) / self.ramp))
+        return v
+
+    def constrain_rates(self, t_mid, state, dt_mid):
+        vc = self.velocity(t_mid)
+        idx = self.nodes
+        r = self.body.mass[idx, None] * (vc[None, :] - state.v_new[idx]) / dt_mid
+        state.reaction[idx] += r
+        state.v_new[idx] = vc
+        return r.sum(axis=0)
+
+
+class LineConstraint(Constraint):
+    """Nodes confined to a straight line (a rigid sheath) while they lie inside its extent.
+
+    A node is guided when its coordinate along the line, s = (x - point) . direction, lies in
+    [s_min, s_max]: its velocity component across the line is removed (motion along the line stays
+    free). Nodes started on the line stay on it.
+
+    Parameters
+    ----------
+    body : body object
+    point, direction : (3,) arrays
+        A point of the line and its direction.
+    extent : (s_min, s_max)
+        Guided stretch of the line, m.
+    nodes : int array or None
+        Candidate nodes (None = all nodes of the body).
+    start, end : float
+        Time window, s.
+    """
+
+    def __init__(self, body, point, direction, extent=(-math.inf, math.inf), nodes=None, start=0.0, end=math.inf):
+        self._init_window(body, nodes, start, end)
+        d = np.asarray(direction, dtype=np.float64).reshape(3)
+        if not np.linalg.norm(d) > 0.0:
+            raise ColonsimError("line constraint direction must be a non-zero vector; fix it.")
+        self.direction = d / np.linalg.norm(d)
+        self.point = np.asarray(point, dtype=np.float64).reshape(3)
+        self.extent = (float(extent[0]), float(extent[1]))
+
+    def constrain_rates(self, t_mid, state, dt_mid):
+        return line_constraint_kernel(state.x, state.v_new, state.reaction, self.body.mass, self.nodes, self.point,
+                                      self.direction, self.extent[0], self.extent[1], dt_mid)
+
+
+class NodalLoad(_Window):
+    """Applied nodal forces while active.
+
+    Parameters
+    ----------
+    body : body object
+    nodes : int array
+    force : (3,) array, (len(nodes), 3) array, or callable t -> one of those
+        Force per node, N.
+    start, end : float
+        Time window, s.
+    """
+
+    def __init__(self, body, nodes, force, start=0.0, end=math.inf):
+        nodes_arr = np.asarray(nodes, dtype=np.int64).ravel()
+        self._init_window(body, nodes, start, end)
+        if len(np.unique(nodes_arr)) != len(nodes_arr):
+            raise ColonsimError("a nodal load lists a node twice; give each node once.")
+        self.nodes = nodes_arr
+        self.force = force
+
+    def add_forces(self, t, f):
+        """Add the load at time t into the force buffer f (n, 3), N."""
+        force = self.force(t) if callable(self.force) else self.force
+        f[self.nodes] += np.asarray(force, dtype=np.float64)

@@ -1,0 +1,198 @@
+"""Narrow phase of the rod-shell contact: penalty, damping and friction forces per candidate pair
+(the law is in :mod:`colonsim.insertion.engine.contact`'s docstring), the power they dissipate,
+and the reactions split onto the rod nodes.
+
+The force kernel is one source compiled threaded and serial (:mod:`._compile`).
+"""
+
+import math
+
+import numba
+import numpy as np
+
+from colonsim.insertion.engine._compile import threaded_and_serial
+
+
+@numba.njit(cache=True, inline="always")
+def point_segment(xs, i, xr, a, b):
+    """Squared distance from wall node i to segment (a, b) and the segment parameter t in [0, 1]."""
+    e0 = xr[b, 0] - xr[a, 0]
+    e1 = xr[b, 1] - xr[a, 1]
+    e2 = xr[b, 2] - xr[a, 2]
+    w0 = xs[i, 0] - xr[a, 0]
+    w1 = xs[i, 1] - xr[a, 1]
+    w2 = xs[i, 2] - xr[a, 2]
+    ee = e0 * e0 + e1 * e1 + e2 * e2
+    t = (w0 * e0 + w1 * e1 + w2 * e2) / ee if ee > 0.0 else 0.0
+    t = min(max(t, 0.0), 1.0)
+    d0 = w0 - t * e0
+    d1 = w1 - t * e1
+    d2 = w2 - t * e2
+    return d0 * d0 + d1 * d1 + d2 * d2, t
+
+
+@numba.njit(cache=True, inline="always")  # a call per node would cost more than its work
+def _contact_one(c, xs, vs, ms, fixed_s, held_n, xr, vr, mr, seg, nodes, ptr, cand, radius, offset, k_free, k_held,
+                 zeta, mu, v_slip, dt, fs, rod_seg, rod_t, rod_k, rod_f, damp_f, fric_f):
+    """Contact of candidate wall node ``nodes[c]``: (energy, damping power, friction power,
+    active 0/1, normal force)."""
+    reach = radius + offset
+    rod_seg[c] = -1
+    i = nodes[c]
+    best = np.inf
+    best_s = -1
+    best_t = 0.0
+    for p in range(ptr[c], ptr[c + 1]):
+        s = cand[p]
+        d2, t = point_segment(xs, i, xr, seg[s, 0], seg[s, 1])
+        if d2 < best:
+            best = d2
+            best_s = s
+            best_t = t
+    if best_s < 0 or best >= reach * reach or best <= 0.0:
+        return 0.0, 0.0, 0.0, 0, 0.0
+    dist = math.sqrt(best)
+    pen = reach - dist
+    a = seg[best_s, 0]
+    b = seg[best_s, 1]
+    t = best_t
+    if fixed_s[i] and (held_n[i, 0] != 0.0 or held_n[i, 1] != 0.0 or held_n[i, 2] != 0.0):
+        # a point of the rigid fixed wall: it pushes along that wall's normal at rest
+        n0 = held_n[i, 0]
+        n1 = held_n[i, 1]
+        n2 = held_n[i, 2]
+    else:
+        n0 = (xs[i, 0] - ((1.0 - t) * xr[a, 0] + t * xr[b, 0])) / dist
+        n1 = (xs[i, 1] - ((1.0 - t) * xr[a, 1] + t * xr[b, 1])) / dist
+        n2 = (xs[i, 2] - ((1.0 - t) * xr[a, 2] + t * xr[b, 2])) / dist
+    mrc = (1.0 - t) * mr[a] + t * mr[b]
+    meff = mrc if fixed_s[i] else ms[i] * mrc / (ms[i] + mrc)
+    k = k_held if fixed_s[i] else k_free
+    u0 = vs[i, 0] - ((1.0 - t) * vr[a, 0] + t * vr[b, 0])
+    u1 = vs[i, 1] - ((1.0 - t) * vr[a, 1] + t * vr[b, 1])
+    u2 = vs[i, 2] - ((1.0 - t) * vr[a, 2] + t * vr[b, 2])
+    vn = u0 * n0 + u1 * n1 + u2 * n2
+    elastic = k * pen
+    fn = elastic - 2.0 * zeta * math.sqrt(k * meff) * vn
+    if fn < 0.0:
+        fn = 0.0
+    energy = 0.5 * k * pen * pen
+    p_damp = -(fn - elastic) * vn
+    damp_f[c, 0] = (fn - elastic) * n0
+    damp_f[c, 1] = (fn - elastic) * n1
+    damp_f[c, 2] = (fn - elastic) * n2
+    t0 = u0 - vn * n0
+    t1 = u1 - vn * n1
+    t2 = u2 - vn * n2
+    vt = math.sqrt(t0 * t0 + t1 * t1 + t2 * t2)
+    ft = 0.0
+    p_fric = 0.0
+    if mu > 0.0 and fn > 0.0:
+        vreg = max(v_slip, mu * fn * dt / meff)
+        ft = mu * fn / max(vt, vreg)
+        p_fric = ft * vt * vt
+    fric_f[c, 0] = -ft * t0
+    fric_f[c, 1] = -ft * t1
+    fric_f[c, 2] = -ft * t2
+    f0 = fn * n0 - ft * t0
+    f1 = fn * n1 - ft * t1
+    f2 = fn * n2 - ft * t2
+    fs[i, 0] += f0
+    fs[i, 1] += f1
+    fs[i, 2] += f2
+    rod_seg[c] = best_s
+    rod_t[c] = t
+    rod_k[c] = k
+    rod_f[c, 0] = -f0
+    rod_f[c, 1] = -f1
+    rod_f[c, 2] = -f2
+    return energy, p_damp, p_fric, 1, fn
+
+
+def _contact_forces(xs, vs, ms, fixed_s, held_n, xr, vr, mr, seg, nodes, ptr, cand, radius, offset, k_free, k_held,
+                    zeta, mu, v_slip, dt, fs, rod_seg, rod_t, rod_k, rod_f, damp_f, fric_f):
+    """Penalty contact forces on the candidate wall nodes (added into ``fs``) and the reactions on
+    the rod per candidate (``rod_seg`` = -1 if not in contact, ``rod_t``, ``rod_k`` the penalty
+    used, ``rod_f``); the damping and friction parts of the force on the wall node go to
+    ``damp_f`` and ``fric_f``. Free wall nodes get the penalty ``k_free``, held ones ``k_held``.
+
+    Returns
+    -------
+    energy : float
+        Penalty energy sum k g^2 / 2, J.
+    p_damp, p_fric : float
+        Power dissipated by contact damping and by friction, W (>= 0).
+    n_active : int
+    normal : float
+        Sum of the normal forces, N.
+    """
+    energy = 0.0
+    p_damp = 0.0
+    p_fric = 0.0
+    n_active = 0
+    normal = 0.0
+    for c in numba.prange(nodes.shape[0]):
+        e, pd, pf, a, fn = _contact_one(c, xs, vs, ms, fixed_s, held_n, xr, vr, mr, seg, nodes, ptr, cand, radius,
+                                        offset, k_free, k_held, zeta, mu, v_slip, dt, fs, rod_seg, rod_t, rod_k,
+                                        rod_f, damp_f, fric_f)
+        energy += e
+        p_damp += pd
+        p_fric += pf
+        n_active += a
+        normal += fn
+    return energy, p_damp, p_fric, n_active, normal
+
+
+contact_kernel, contact_kernel_serial = threaded_and_serial(_contact_forces)
+
+
+@numba.njit(cache=True)
+def dissipation_rates(vs, vr, seg, nodes, rod_seg, rod_t, damp_f, fric_f):
+    """Power (W, >= 0) taken out by the stored damping and friction forces at velocities vs, vr
+    (serial: a few flops per contact)."""
+    p_damp = 0.0
+    p_fric = 0.0
+    for c in range(nodes.shape[0]):
+        s = rod_seg[c]
+        if s < 0:
+            continue
+        i = nodes[c]
+        a = seg[s, 0]
+        b = seg[s, 1]
+        t = rod_t[c]
+        for k in range(3):
+            u = vs[i, k] - ((1.0 - t) * vr[a, k] + t * vr[b, k])
+            p_damp -= damp_f[c, k] * u
+            p_fric -= fric_f[c, k] * u
+    return p_damp, p_fric
+
+
+@numba.njit(cache=True)
+def rod_reactions(seg, rod_seg, rod_t, rod_k, rod_f, mr, fr, load):
+    """Linear split of the contact reactions onto the rod nodes (serial: contacts are few and
+    several of them share rod nodes). Returns the total force on the rod and
+    max over rod nodes of (penalty stiffness acting on it / mass), 1/s^2."""
+    for j in range(load.shape[0]):
+        load[j] = 0.0
+    t0 = 0.0
+    t1 = 0.0
+    t2 = 0.0
+    for c in range(rod_seg.shape[0]):
+        s = rod_seg[c]
+        if s < 0:
+            continue
+        a = seg[s, 0]
+        b = seg[s, 1]
+        t = rod_t[c]
+        for k in range(3):
+            fr[a, k] += (1.0 - t) * rod_f[c, k]
+            fr[b, k] += t * rod_f[c, k]
+        load[a] += (1.0 - t) * rod_k[c]
+        load[b] += t * rod_k[c]
+        t0 += rod_f[c, 0]
+        t1 += rod_f[c, 1]
+        t2 += rod_f[c, 2]
+    worst = 0.0
+    for j in range(load.shape[0]):
+        worst = max(worst, load[j] / mr[j])
+    return t0, t1, t2, worst

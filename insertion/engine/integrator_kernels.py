@@ -1,0 +1,88 @@
+"""Nodal kernels of the explicit integrator (docs/model.md, "Time integration"): the damped
+velocity update and the position update with the work of each force family.
+
+Each kernel is one source compiled threaded and serial (:mod:`._compile`); the solver picks the
+serial one for bodies too small to pay for threads.
+"""
+
+import numba
+
+from colonsim.insertion.engine._compile import threaded_and_serial
+
+
+@numba.njit(cache=True, inline="always")  # a call per node would cost more than its work
+def _velocity_node(i, v, f_int, f_con, f_ext, mass, fixed, alpha, dt, v_new, f_damp, reaction):
+    # one division per node: divisions dominate this otherwise memory-bound loop
+    m = mass[i]
+    h = 0.5 * alpha * dt
+    keep = (1.0 - h) / (1.0 + h)
+    gain = dt / (m * (1.0 + h))
+    for k in range(3):
+        ftot = f_int[i, k] + f_con[i, k] + f_ext[i, k]
+        vf = keep * v[i, k] + gain * ftot
+        f_damp[i, k] = -0.5 * alpha * m * (v[i, k] + vf)
+        if fixed[i]:
+            v_new[i, k] = 0.0
+            reaction[i, k] = -vf * (m / dt)
+        else:
+            v_new[i, k] = vf
+            reaction[i, k] = 0.0
+
+
+def _velocity_update(v, f_int, f_con, f_ext, mass, fixed, alpha, dt, v_new, f_damp, reaction):
+    """Damped velocity update into ``v_new``; fixed nodes get zero velocity and their reaction."""
+    for i in numba.prange(v.shape[0]):
+        _velocity_node(i, v, f_int, f_con, f_ext, mass, fixed, alpha, dt, v_new, f_damp, reaction)
+
+
+velocity_kernel, velocity_kernel_serial = threaded_and_serial(_velocity_update)
+
+
+@numba.njit(cache=True, inline="always")  # a call per node would cost more than its work
+def _advance_node(i, x, v, v_new, mass, f_int, f_con, f_ext, f_damp, reaction, dt):
+    w_int = 0.0
+    w_con = 0.0
+    w_ext = 0.0
+    w_damp = 0.0
+    w_react = 0.0
+    kinetic = 0.0
+    for k in range(3):
+        va = 0.5 * (v[i, k] + v_new[i, k])
+        w_int += f_int[i, k] * va
+        w_con += f_con[i, k] * va
+        w_ext += f_ext[i, k] * va
+        w_damp += f_damp[i, k] * va
+        w_react += reaction[i, k] * va
+        kinetic += 0.5 * mass[i] * va * va
+        x[i, k] += dt * v_new[i, k]
+        v[i, k] = v_new[i, k]
+    return w_int, w_con, w_ext, w_damp, w_react, kinetic
+
+
+def _advance(x, v, v_new, mass, f_int, f_con, f_ext, f_damp, reaction, dt_mid, dt):
+    """Work increments of each force family, mid-step kinetic energy; then x += dt v_new, v = v_new.
+
+    Returns
+    -------
+    w_int, w_con, w_ext, w_damp, w_react, kinetic : float
+        Work (J) done on the body during the step by each family, and the kinetic energy at the
+        mid-step velocity (v_old + v_new) / 2.
+    """
+    w_int = 0.0
+    w_con = 0.0
+    w_ext = 0.0
+    w_damp = 0.0
+    w_react = 0.0
+    kinetic = 0.0
+    for i in numba.prange(x.shape[0]):
+        a, b, c, d, e, k = _advance_node(i, x, v, v_new, mass, f_int, f_con, f_ext, f_damp, reaction, dt)
+        w_int += a
+        w_con += b
+        w_ext += c
+        w_damp += d
+        w_react += e
+        kinetic += k
+    return w_int * dt_mid, w_con * dt_mid, w_ext * dt_mid, w_damp * dt_mid, w_react * dt_mid, kinetic
+
+
+advance_kernel, advance_kernel_serial = threaded_and_serial(_advance)
