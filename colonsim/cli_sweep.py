@@ -2,20 +2,13 @@
 
 from __future__ import annotations
 
-import os
 from pathlib import Path
 
 from colonsim.errors import ColonsimError
 from colonsim.files import check_output_folder
 from colonsim.options import output_folder, positive_int
 from colonsim.insertion.case.run_budget import DEFAULT_MAX_STEPS
-
-
-def available_cores() -> int:
-    try:
-        return len(os.sched_getaffinity(0))
-    except AttributeError:  # pragma: no cover - not Linux
-        return os.cpu_count() or 1
+from colonsim.workflows import available_cores
 
 
 def add_parser(sub):

@@ -12,9 +12,11 @@ run and where each file is. Rerunning into the same folder skips the sweep runs 
 
 from __future__ import annotations
 
-import argparse
 import time
+from dataclasses import dataclass
 from pathlib import Path
+
+from colonsim.workflows import available_cores
 
 DEMO_SWEEP = """
 [sweep]
@@ -45,19 +47,15 @@ def _section(text):
 
 
 def calibrate_step(out: Path, show: bool):
-    from colonsim.cli import run_calibration
+    from colonsim.workflows import CalibrationRequest, calibrate
 
     _section("1/5 calibrate Mooney-Rivlin parameters from the bundled SYNTHETIC tensile data (data/README.md); "
              "reduced budget (--quick)")
-    args = argparse.Namespace(manifest=None, curve=None, length=None, width=None, thickness=None,
-                              displacement_unit=None, force_unit=None, per_specimen=False, law="mooney_rivlin_3",
-                              compare_laws=False, analytic=False, mesh=(8, 3), points=20, quick=True, seed=1, workers=1,
-                              no_progress=not show)
-    return run_calibration(args, out)[0]
+    return calibrate(CalibrationRequest(law="mooney_rivlin_3", quick=True, workers=1, show_progress=show), out)[0]
 
 
 def insertion_step(material: Path, element_size: float, out: Path, show: bool):
-    from colonsim.cli import run_insertions
+    from colonsim.workflows import insert
     from colonsim.insertion.case.scenario import InsertionCase
 
     _section("2/5 RSJ insertions (D = 36 mm, mu = 0) of the three scopes with the calibrated material; "
@@ -70,7 +68,7 @@ def insertion_step(material: Path, element_size: float, out: Path, show: bool):
     numba.set_num_threads(1)
     cases = [InsertionCase(segment="rsj", scope=s, diameter_mm=36.0, material=str(material),
                            element_size_mm=element_size) for s in ("utc", "pdc", "sdc")]
-    return run_insertions(cases, out, show=show)
+    return insert(cases, out, show=show)
 
 
 def sweep_step(material: Path, element_size: float, out: Path, workers: int, show: bool):
@@ -195,28 +193,37 @@ def print_summary(calibration, insertions, model, recs):
               f"{best['scope'].upper()} {best['mean']:.2f} cm)")
 
 
-def run_demo(args):
-    out: Path = args.out
-    show = not args.no_progress
-    from colonsim.cli_sweep import available_cores
+@dataclass(frozen=True)
+class DemoOptions:
+    """Where the demo writes, its wall mesh (mm), sweep processes (None: up to 2 cores) and bars."""
 
-    workers = args.workers or min(2, available_cores())
+    out: Path = Path("colonsim_demo")
+    element_size_mm: float = 3.0
+    workers: int | None = None
+    show_progress: bool = True
+
+
+def run_demo(options: DemoOptions):
+    """Run the five steps into ``options.out`` and print the summary."""
+    out = Path(options.out)
+    show = options.show_progress
+    workers = options.workers or min(2, available_cores())
     seconds = {}
     t0 = time.perf_counter()
     calibration = calibrate_step(out / "calibration", show)
     seconds["calibration"] = time.perf_counter() - t0
     material = out / "calibration" / "material.json"
     t = time.perf_counter()
-    insertions = insertion_step(material, args.element_size, out / "insertion", show)
+    insertions = insertion_step(material, options.element_size_mm, out / "insertion", show)
     seconds["insertions"] = time.perf_counter() - t
     t = time.perf_counter()
-    sweep = sweep_step(material, args.element_size, out / "sweep", workers, show)
+    sweep = sweep_step(material, options.element_size_mm, out / "sweep", workers, show)
     seconds["sweep"] = time.perf_counter() - t
     t = time.perf_counter()
     model, _, _ = surrogate_step(out / "sweep" / "results.parquet", out)
     recs = recommend_step(model, out)
     seconds["surrogate and recommendations"] = time.perf_counter() - t
-    report = write_report(out, calibration, insertions, sweep, model, recs, seconds, args.element_size)
+    report = write_report(out, calibration, insertions, sweep, model, recs, seconds, options.element_size_mm)
     print_summary(calibration, insertions, model, recs)
     print(f"\ndemo finished in {time.perf_counter() - t0:.0f} s; report: {report}; every file in {out}/")
     print("Next: `colonsim sweep --preset thesis` runs the source's 39 insertions; `colonsim surrogate fit` and "

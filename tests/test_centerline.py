@@ -4,8 +4,8 @@ import numpy as np
 import pytest
 
 from colonsim.errors import ColonsimError
-from colonsim.insertion.anatomy.centerline import (EXIT_LENGTH, FILLET_RADIUS, FLEXURE_ANGLE_DEG, FLEXURE_RADIUS, Arc, Centerline,
-                                  Kink, Straight, rsf_centerline, rsj_centerline, thf_centerline, thf_fixed_centerline)
+from colonsim.insertion.anatomy.centerline import FILLET_RADIUS, FLEXURE_RADIUS, Arc, Centerline, Kink, Straight
+from colonsim.insertion.anatomy.colon_centerlines import EXIT_LENGTH, FLEXURE_ANGLE_DEG, rsf_centerline, rsj_centerline, thf_centerline, thf_fixed_centerline
 
 R, RF = FLEXURE_RADIUS, FILLET_RADIUS
 

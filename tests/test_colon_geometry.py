@@ -4,8 +4,8 @@ import numpy as np
 import pytest
 
 from colonsim.errors import ColonsimError
-from colonsim.insertion.anatomy.centerline import (Arc, Centerline, Kink, Straight, rsf_centerline, rsj_centerline, thf_centerline,
-                                  thf_fixed_centerline)
+from colonsim.insertion.anatomy.centerline import Arc, Centerline, Kink, Straight
+from colonsim.insertion.anatomy.colon_centerlines import rsf_centerline, rsj_centerline, thf_centerline, thf_fixed_centerline
 from colonsim.insertion.anatomy.colon_geometry import enclosed_volume, tube_mesh
 from colonsim.insertion.study.reference import SOURCE_MESHES
 from colonsim.insertion.engine.sheet_mesh import hinges

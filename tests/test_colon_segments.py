@@ -5,8 +5,8 @@ import numpy as np
 import pytest
 
 from colonsim.errors import ColonsimError
-from colonsim.insertion.anatomy.centerline import (EXIT_LENGTH, FILLET_RADIUS, FLEXURE_RADIUS, rsf_centerline, rsj_centerline,
-                                  thf_centerline, thf_fixed_centerline)
+from colonsim.insertion.anatomy.centerline import FILLET_RADIUS, FLEXURE_RADIUS
+from colonsim.insertion.anatomy.colon_centerlines import EXIT_LENGTH, rsf_centerline, rsj_centerline, thf_centerline, thf_fixed_centerline
 from colonsim.insertion.anatomy.colon_geometry import tube_mesh
 from colonsim.insertion.anatomy.colon_segments import PAST_JUNCTION, colon_geometry
 

@@ -30,8 +30,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from colonsim.errors import ColonsimError
-from colonsim.insertion.anatomy.centerline import (EXIT_LENGTH, FLEXURE_ANGLE_DEG, Straight, rsf_centerline, rsj_centerline,
-                                  thf_centerline, thf_fixed_centerline)
+from colonsim.insertion.anatomy.centerline import Straight
+from colonsim.insertion.anatomy.colon_centerlines import EXIT_LENGTH, FLEXURE_ANGLE_DEG, rsf_centerline, rsj_centerline, thf_centerline, thf_fixed_centerline
 from colonsim.insertion.anatomy.colon_geometry import tube_mesh
 from colonsim.insertion.engine.sheet_mesh import straight_tube
 
