@@ -9,25 +9,54 @@ per-step time, element updates per second per core
 ((triangles + hinges + rod segments + contact candidates) * steps / wall / cores) and the
 projected wall time of a 0.5 s simulated push at the solver's time step.
 
-Run: ``python benchmarks/bench_solver.py [--steps 2000] [--threads 2] [--mesh 3e-3] [--rod-spacing 5e-3] [--repeat 1]``
+Run: ``python benchmarks/bench_solver.py [--steps 2000] [--threads 2] [--mesh 3e-3] [--rod-spacing 5e-3] [--repeat 1]
+[--baseline CHECKOUT]``
 
 On a shared machine single timings vary by +-15 %: ``--repeat 5`` times five runs of ``--steps``
-steps each (one model, continuing in time) and reports the median.
+steps each (one model, continuing in time) and reports the median. ``--baseline`` builds the same
+model with another checkout's engine in the same process and alternates their timed runs, so both
+see the same machine load; it prints the ratio and whether the final positions are identical.
 """
 
 import argparse
+import importlib
+import sys
 import time
+from pathlib import Path
+from types import SimpleNamespace
 
 import numba
 import numpy as np
 
-from colonsim.insertion.engine.contact import RodShellContact
-from colonsim.insertion.engine.material import REFERENCE_MATERIAL_PATH, load_material
-from colonsim.insertion.engine.rod import Rod
-from colonsim.insertion.engine.sheet_mesh import straight_tube
-from colonsim.insertion.engine.shell import Shell
-from colonsim.insertion.engine.constraints import FixedNodes, LineConstraint, NodalLoad, PrescribedVelocity
-from colonsim.insertion.engine.solver import ExplicitSolver
+# Where the engine's names live: this checkout, and the layout before the one-package restructure
+# (top-level insertion/, commit 49ddc62 and earlier), which can be imported beside it for --baseline.
+CURRENT = {"RodShellContact": "colonsim.insertion.engine.contact", "REFERENCE_MATERIAL_PATH": "colonsim.data",
+           "load_material": "colonsim.insertion.engine.material", "Rod": "colonsim.insertion.engine.rod",
+           "straight_tube": "colonsim.insertion.engine.sheet_mesh", "Shell": "colonsim.insertion.engine.shell",
+           "FixedNodes": "colonsim.insertion.engine.constraints", "LineConstraint": "colonsim.insertion.engine.constraints",
+           "NodalLoad": "colonsim.insertion.engine.constraints",
+           "PrescribedVelocity": "colonsim.insertion.engine.constraints",
+           "ExplicitSolver": "colonsim.insertion.engine.solver"}
+BEFORE_PACKAGE = {"RodShellContact": "insertion.contact", "REFERENCE_MATERIAL_PATH": "insertion.material",
+                  "load_material": "insertion.material", "Rod": "insertion.rod", "straight_tube": "insertion.sheet_mesh",
+                  "Shell": "insertion.shell", "FixedNodes": "insertion.solver", "LineConstraint": "insertion.solver",
+                  "NodalLoad": "insertion.solver", "PrescribedVelocity": "insertion.solver",
+                  "ExplicitSolver": "insertion.solver"}
+
+
+def engine(layout):
+    """The engine's classes and functions, imported from ``layout`` (a name -> module map)."""
+    return SimpleNamespace(**{name: getattr(importlib.import_module(module), name) for name, module in layout.items()})
+
+
+def baseline_engine(checkout):
+    """The engine of another checkout in the layout before the one-package restructure."""
+    if not (Path(checkout) / "insertion" / "solver.py").is_file():
+        sys.exit(f"--baseline {checkout}: not a checkout with insertion/solver.py (the layout before the colonsim "
+                 "package; e.g. `git worktree add /tmp/base 49ddc62`)")
+    sys.path.insert(0, str(checkout))
+    return engine(BEFORE_PACKAGE)
+
 
 LUMEN = 0.036
 WALL = 2e-3
@@ -36,28 +65,62 @@ SCOPE_LENGTH = 0.7
 SCOPE_D = 12.8e-3
 
 
-def build(mesh_size=3e-3, rod_spacing=5e-3, friction=0.1):
-    """The reference model: solver, shell, rod, contact."""
-    nodes, tri, ring = straight_tube(TUBE_LENGTH, LUMEN + WALL, mesh_size)
-    colon = Shell(nodes, tri, WALL, load_material(REFERENCE_MATERIAL_PATH), density=1040.0, name="colon")
+def build(e, mesh_size=3e-3, rod_spacing=5e-3, friction=0.1):
+    """The reference model built with engine ``e``: solver, shell, rod, contact."""
+    nodes, tri, ring = e.straight_tube(TUBE_LENGTH, LUMEN + WALL, mesh_size)
+    colon = e.Shell(nodes, tri, WALL, e.load_material(e.REFERENCE_MATERIAL_PATH), density=1040.0, name="colon")
     ends = np.flatnonzero((ring == 0) | (ring == ring.max()))
     # scope axis on the lumen floor, 0.1 mm into the contact layer so the contact is active
     reach = 0.5 * SCOPE_D + 0.5 * WALL
     y_axis = -(0.5 * (LUMEN + WALL) - reach + 1e-4)
     start = (0.25 - SCOPE_LENGTH, y_axis, 0.0)
-    scope = Rod.straight(SCOPE_LENGTH, SCOPE_D, 16e6, 2944.0, spacing=rod_spacing, start=start)
-    contact = RodShellContact(scope, colon, friction=friction)
-    push = PrescribedVelocity(scope, [0], (0.6, 0.0, 0.0), ramp=0.02)
-    sheath = LineConstraint(scope, start, (1.0, 0.0, 0.0), extent=(-1.0, -start[0] - 0.005))
-    weight = NodalLoad(scope, np.arange(scope.n_nodes), np.outer(scope.mass * 9.81, (0.0, -1.0, 0.0)))
-    sim = ExplicitSolver(
+    scope = e.Rod.straight(SCOPE_LENGTH, SCOPE_D, 16e6, 2944.0, spacing=rod_spacing, start=start)
+    contact = e.RodShellContact(scope, colon, friction=friction)
+    push = e.PrescribedVelocity(scope, [0], (0.6, 0.0, 0.0), ramp=0.02)
+    sheath = e.LineConstraint(scope, start, (1.0, 0.0, 0.0), extent=(-1.0, -start[0] - 0.005))
+    weight = e.NodalLoad(scope, np.arange(scope.n_nodes), np.outer(scope.mass * 9.81, (0.0, -1.0, 0.0)))
+    sim = e.ExplicitSolver(
         [scope, colon],
         contacts=[contact],
-        constraints=[FixedNodes(colon, ends), push, sheath],
+        constraints=[e.FixedNodes(colon, ends), push, sheath],
         loads=[weight],
         damping={"colon": 20.0, "scope": 20.0},
     )
     return sim, colon, scope, contact
+
+
+class TimedModel:
+    """The reference model of one engine, warmed up, timed in runs of a number of steps."""
+
+    def __init__(self, e, args):
+        t0 = time.perf_counter()
+        self.sim, self.colon, self.scope, self.contact = build(e, mesh_size=args.mesh, rod_spacing=args.rod_spacing)
+        for _ in range(20):  # compile and build the candidate list
+            self.sim.advance()
+        self.warm = time.perf_counter() - t0
+        self.runs = []  # (wall, candidates, shell time) of each timed run
+        self._shell_time = 0.0
+        shell_forces = self.colon.internal_forces
+
+        def timed_shell_forces(x, f):  # the wall's internal forces (membrane + hinges) inside the run
+            t = time.perf_counter()
+            energy = shell_forces(x, f)
+            self._shell_time += time.perf_counter() - t
+            return energy
+
+        self.colon.internal_forces = timed_shell_forces
+
+    def run(self, steps):
+        cand = 0
+        self._shell_time = 0.0
+        t0 = time.perf_counter()
+        for _ in range(steps):
+            self.sim.advance()
+            cand += self.contact.n_candidates
+        self.runs.append((time.perf_counter() - t0, cand, self._shell_time))
+
+    def median(self):
+        return sorted(self.runs)[len(self.runs) // 2]
 
 
 def main():
@@ -68,60 +131,47 @@ def main():
     parser.add_argument("--mesh", type=float, default=3e-3, help="wall triangle size, m")
     parser.add_argument("--rod-spacing", type=float, default=5e-3, help="scope node spacing, m")
     parser.add_argument("--repeat", type=int, default=1, help="timed runs of --steps steps; the median is reported")
+    parser.add_argument("--baseline", type=Path, default=None,
+                        help="a checkout in the layout before the colonsim package (e.g. commit 49ddc62): its "
+                             "engine runs the same model in this process, timed run for run alternately")
     args = parser.parse_args()
     if args.threads:
         numba.set_num_threads(args.threads)
     cores = numba.get_num_threads()
-
-    t0 = time.perf_counter()
-    sim, colon, scope, contact = build(mesh_size=args.mesh, rod_spacing=args.rod_spacing)
-    for _ in range(20):  # compile and build the candidate list
-        sim.advance()
-    warm = time.perf_counter() - t0
-
-    elements = len(colon.triangles) + len(colon.hinges) + len(scope.segments)
-    # time the wall's internal forces (membrane + hinges) inside the run
-    shell_time = [0.0]
-    shell_forces = colon.internal_forces
-
-    def timed_shell_forces(x, f):
-        t = time.perf_counter()
-        energy = shell_forces(x, f)
-        shell_time[0] += time.perf_counter() - t
-        return energy
-
-    colon.internal_forces = timed_shell_forces
-    runs = []  # (wall, candidates, shell time) of each timed run
+    model = TimedModel(engine(CURRENT), args)
+    base = TimedModel(baseline_engine(args.baseline), args) if args.baseline else None
     for _ in range(max(args.repeat, 1)):
-        cand = 0
-        shell_time[0] = 0.0
-        t0 = time.perf_counter()
-        for _ in range(args.steps):
-            sim.advance()
-            cand += contact.n_candidates
-        runs.append((time.perf_counter() - t0, cand, shell_time[0]))
-    colon.internal_forces = shell_forces
-    wall, cand, shell_wall = sorted(runs)[len(runs) // 2]
-    shell_share = shell_wall / wall
-
+        model.run(args.steps)
+        if base is not None:
+            base.run(args.steps)
+    sim, colon, scope, contact = model.sim, model.colon, model.scope, model.contact
+    wall, cand, shell_wall = model.median()
+    elements = len(colon.triangles) + len(colon.hinges) + len(scope.segments)
     per_step = wall / args.steps
     updates = (elements * args.steps + cand) / wall / cores
     steps_push = args.push / sim.dt
     print(f"model: {len(colon.triangles)} triangles, {len(colon.hinges)} hinges, {len(scope.segments)} rod segments, "
           f"{contact.n_candidates} contact candidates ({contact.n_active} in contact), {cores} thread(s)")
-    print(f"warm-up (compile + first steps): {warm:.1f} s")
+    print(f"warm-up (compile + first steps): {model.warm:.1f} s")
     limits = {b.name: b.critical_time_step(sim.state[b.name].x) for b in sim.bodies}
     limits["contact"] = contact.critical_time_step()
     print(f"time step: {sim.dt:.3e} s  ->  {steps_push:.0f} steps for a {args.push} s push "
           f"(stable steps alone: " + ", ".join(f"{k} {v:.2e} s" for k, v in limits.items()) + ")")
     print(f"per step: {per_step * 1e3:.3f} ms over {args.steps} steps (simulated {sim.time:.4f} s); "
-          f"wall internal forces ~{100 * shell_share:.0f} % of it")
+          f"wall internal forces ~{100 * shell_wall / wall:.0f} % of it")
     print(f"element updates per second per core: {updates / 1e6:.1f} M")
     print(f"projected wall time of a {args.push} s push: {steps_push * per_step:.0f} s")
-    if len(runs) > 1:
-        print(f"per step in each of the {len(runs)} runs (median reported above): "
-              + ", ".join(f"{w / args.steps * 1e3:.3f}" for w, _, _ in runs) + " ms")
+    if len(model.runs) > 1:
+        print(f"per step in each of the {len(model.runs)} runs (median reported above): "
+              + ", ".join(f"{w / args.steps * 1e3:.3f}" for w, _, _ in model.runs) + " ms")
     print(f"candidate rebuilds: {contact.n_rebuilds}; tip at x = {sim.state['scope'].x[scope.tip_node, 0]:.4f} m")
+    if base is not None:
+        base_wall = base.median()[0]
+        same = np.array_equal(sim.state["colon"].x, base.sim.state["colon"].x) and np.array_equal(
+            sim.state["scope"].x, base.sim.state["scope"].x)
+        print(f"baseline {args.baseline}: per step {base_wall / args.steps * 1e3:.3f} ms (runs "
+              + ", ".join(f"{w / args.steps * 1e3:.3f}" for w, _, _ in base.runs) + " ms); this checkout / baseline = "
+              f"{wall / base_wall:.3f}; final positions {'identical' if same else 'DIFFER'}")
 
 
 if __name__ == "__main__":
