@@ -1,4 +1,4 @@
-"""Nodal kernels of the explicit integrator (docs/model.md, "Time integration"): the damped
+"""Nodal kernels of the explicit integrator (docs/model.md, "Time integration and damping"): the damped
 velocity update and the position update with the work of each force family.
 
 Each kernel is one source compiled threaded and serial (:mod:`._compile`); the solver picks the
