@@ -46,6 +46,7 @@ def log_marginal_likelihood(theta, X, y, eval_gradient=True):
     r2 = sq[:, None] + sq[None, :] - 2.0 * (Xl @ Xl.T)
     np.fill_diagonal(r2, 0.0)
     r = np.sqrt(np.maximum(r2, 0.0))
+    # kernel.matern52 written out: the gradient below reuses r, r2 and e
     e = np.exp(-SQRT5 * r)
     K = c * (1.0 + SQRT5 * r + 5.0 / 3.0 * r2) * e
     K[np.diag_indices(n)] += s + JITTER
