@@ -8,9 +8,9 @@ target is standardized. Hyperparameters maximize the log marginal likelihood (L-
 restarts); prediction is numpy from the stored Cholesky factor.
 
 Hand-written rather than scikit-learn's ``GaussianProcessRegressor`` configured as the same model,
-because it is faster at the same likelihood: the fit with hyperparameter optimisation 2-5x
-(500 runs, 5 inputs: 1.7 s against 7.0 s), one query 3-5x (0.11-0.12 ms against 0.35-0.39 ms
-at 500 runs, 0.06 ms against 0.3 ms at 40), and a saved model needs neither the library nor
+because it is faster at the same likelihood: the fit with hyperparameter optimisation 1.7-4x
+(500 runs, 5 inputs: 3.0 s against 12.2 s), one query 2.4-9x (500 runs: 0.19 ms against
+0.45 ms; 40 runs: 0.06 ms against 0.49 ms), and a saved model needs neither the library nor
 pickle. Measured by ``NUMBA_NUM_THREADS=1 python benchmarks/bench_surrogate.py`` (docs/surrogate.md).
 """
 

@@ -7,9 +7,9 @@ scikit-learn's ``ConstantKernel * Matern + WhiteKernel``, so the two can be comp
 
 Written out because scikit-learn's gradient builds and contracts an (n, n, p) tensor; here every
 term is an (n, n) elementwise product or a matrix product. One evaluation of value and gradient
-is 2.6-3.7x faster than ``GaussianProcessRegressor.log_marginal_likelihood(theta,
-eval_gradient=True)`` (500 runs, 5 inputs: 18 ms against 45 ms), which makes
-the whole fit 2-5x faster. Measured by ``NUMBA_NUM_THREADS=1 python benchmarks/bench_surrogate.py``.
+is 2.5-3.8x faster than ``GaussianProcessRegressor.log_marginal_likelihood(theta,
+eval_gradient=True)`` (500 runs, 5 inputs: 28 ms against 105 ms), which makes the whole fit
+1.7-4x faster. Measured by ``NUMBA_NUM_THREADS=1 python benchmarks/bench_surrogate.py``.
 """
 
 from __future__ import annotations
