@@ -39,11 +39,13 @@ def add_parser(sub):
 
 def cmd_sweep(args):
     from colonsim.insertion.case.run_budget import check_sweep_budget
-    from colonsim.insertion.study.sweep import SweepStore, describe_cases, run_sweep
+    from colonsim.insertion.study.sweep import SweepStore, dask_distributed, describe_cases, run_sweep
     from colonsim.insertion.study.sweep_spec import load_sweep
 
     if args.scheduler is not None and args.workers is not None:
         raise ColonsimError("--workers is for local runs; a Dask cluster (--scheduler) has its own workers")
+    if args.scheduler is not None and not args.dry_run:
+        dask_distributed()  # a missing dask fails before the sweep is announced or anything written
     workers = available_cores() if args.workers is None else args.workers
     spec = load_sweep(args.spec, args.preset)
     out = args.out or check_output_folder(Path("colonsim_results") / f"sweep_{spec.name}")

@@ -182,12 +182,6 @@ class SweepSurrogate:
         Xm, _, _ = domain.check(self.query(domain.segment, X), strict=strict)
         return gp.predict(Xm, return_std=return_std)
 
-    def predict_cov(self, X, segment, target="final_deformation_cm", strict=False):
-        """Mean and joint covariance of the smooth trend (no scatter) at the rows of ``X``."""
-        domain, gp = self.model_for(segment, target)
-        Xm, _, _ = domain.check(self.query(domain.segment, X), strict=strict)
-        return gp.predict(Xm, return_cov=True)
-
     def predict_frame(self, frame: pd.DataFrame, targets=None, segment=None, strict=False) -> pd.DataFrame:
         """Batch prediction: one row per query row, per target its mean, std and 95 % interval.
 

@@ -87,3 +87,24 @@ def test_bad_input_is_one_line_and_exit_2(fitted, args, message, capsys):
     assert main(args) == 2
     err = capsys.readouterr().err.strip()
     assert err.startswith("colonsim: error:") and message in err and len(err.splitlines()) == 1
+
+
+def test_the_surrogate_runs_without_scikit_learn(tmp_path):
+    """scikit-learn is a test dependency only: fit, info, predict, recommend and plot never import it."""
+    import subprocess
+    import sys
+
+    synthetic_sweep(design="grid", noise_cm=0.02, seed=1).to_parquet(tmp_path / "results.parquet")
+    script = ("import sys\n"
+              "sys.modules['sklearn'] = None  # `import sklearn` raises ImportError from here on\n"
+              "from colonsim.cli import main\n"
+              "for args in (['surrogate', 'fit', 'results.parquet', '-o', 'model', '--restarts', '0'],\n"
+              "             ['surrogate', 'info', 'model.json'], ['predict', 'model.json', '--segment', 'rsf', '--sex', 'female', '--age', 'young'],\n"
+              "             ['recommend', 'model.json', '--segment', 'rsj', '--region', 'european', '--age', 'middle'],\n"
+              "             ['surrogate', 'plot', 'model.json', '--segment', 'rsf', '--vs', 'angle', '--friction', '0.05',\n"
+              "              '-o', 'f.png']):\n"
+              "    assert main(args) == 0, args\n"
+              "assert not [m for m in sys.modules if m.startswith('sklearn.')]\n")
+    done = subprocess.run([sys.executable, "-c", script], cwd=tmp_path, capture_output=True, text=True, timeout=300)
+    assert done.returncode == 0, done.stderr[-2000:]
+    assert (tmp_path / "f.png").is_file()

@@ -295,7 +295,7 @@ def dask_outcomes(cases, address, runner=None, log=print):
     core): runs within a worker process are serialized anyway. Each worker loads the kernels
     once, at its first run (outside the timed part), which also covers workers that join late.
     """
-    from distributed import Client
+    Client = dask_distributed().Client
 
     try:  # connect now, so an unreachable scheduler fails before anything is written
         client = Client(address, timeout="15s", set_as_default=False)
@@ -305,8 +305,18 @@ def dask_outcomes(cases, address, runner=None, log=print):
     return _dask_stream(client, cases, address, runner, log)
 
 
+def dask_distributed():
+    """The ``distributed`` package (the ``cluster`` extra), or a one-line error naming the fix."""
+    try:
+        import distributed
+    except ImportError as exc:
+        raise ColonsimError(f'running on a Dask cluster (--scheduler) needs dask ({exc}); '
+                            'pip install "colonsim[cluster]"') from None
+    return distributed
+
+
 def _dask_stream(client, cases, address, runner, log):
-    from distributed import as_completed
+    as_completed = dask_distributed().as_completed
 
     with client:
         workers = client.scheduler_info().get("workers", {})
@@ -378,6 +388,8 @@ def run_sweep(cases, out, workers=2, scheduler=None, runner=None, retry_failed=F
         raise ColonsimError(f"workers = {workers}; give at least 1 worker process")
     for case in cases:
         case.validate()
+    if scheduler:
+        dask_distributed()  # a missing dask fails before anything is written
     out = check_output_folder(out)
     check_sweep_budget(cases, max_steps)
     t0 = time.perf_counter()
