@@ -9,7 +9,8 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from colonsim.catalog import NAMED_SCOPES, SCOPE_DENSITY, SCOPE_POISSON, SCOPE_YOUNGS_MODULUS, parse_scope, standard_scope
+from colonsim.catalog import (NAMED_SCOPES, SCOPE_DENSITY, SCOPE_POISSON, SCOPE_YOUNGS_MODULUS, parse_scope,
+                              standard_scope)
 from colonsim.errors import ColonsimError
 from colonsim.insertion.engine.rod import Rod
 
