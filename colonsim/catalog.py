@@ -111,17 +111,17 @@ class ColonModel:
 
 
 COLON_MODELS = {m.name: m for m in (
-    ColonModel("rsj", "rectosigmoid junction: rectum, the mobile sigmoid as a half circle, fixed exit",
+    ColonModel("rsj", "rectosigmoid junction",
                f"{_BUILDERS}:rsj_geometry", 0.30, mobile_piece="sigmoid", end_rule=PAST_MOBILE_END),
-    ColonModel("rsf", "rectum to splenic flexure, the mobile sigmoid tilted by alpha",
+    ColonModel("rsf", "rectum to splenic flexure, the sigmoid tilted by alpha",
                f"{_BUILDERS}:rsf_geometry", 0.70, ALPHA, ANGLE_LIMITS_DEG, STRAIGHTEN_RELAX_PUSH, "sigmoid",
                FAR_END_OR_LENGTH, surrogate_angle=True),
-    ColonModel("thf", "transverse colon as a mobile V of angle beta, hepatic flexure",
+    ColonModel("thf", "transverse colon as a V of angle beta, hepatic flexure",
                f"{_BUILDERS}:thf_geometry", 0.50, BETA, ANGLE_LIMITS_DEG, STRAIGHTEN_RELAX_PUSH, "transverse",
                FAR_END_OR_LENGTH, surrogate_angle=True),
-    ColonModel("thf-fixed", "thf with the transverse colon fixed too",
+    ColonModel("thf-fixed", "thf with the transverse colon fixed",
                f"{_BUILDERS}:thf_fixed_geometry", 0.50, BETA, ANGLE_LIMITS_DEG, end_rule=FAR_END_OR_LENGTH),
-    ColonModel("straight", "a 20 cm straight mobile tube (sanity case, not one of the source's models)",
+    ColonModel("straight", "a 20 cm straight tube, a sanity case",
                f"{_BUILDERS}:straight_geometry", 0.30),
 )}
 
@@ -142,7 +142,7 @@ def colon_model(name) -> ColonModel:
 
 def segment_help() -> str:
     """Help text of ``--segment``: each model with its title."""
-    return "; ".join(f"{m.name}: {m.title}" for m in COLON_MODELS.values())
+    return ", ".join(f"{m.name} ({m.title})" for m in COLON_MODELS.values())
 
 
 def angle_help() -> str:
@@ -152,9 +152,9 @@ def angle_help() -> str:
         models = [m for m in COLON_MODELS.values() if m.angle == symbol]
         if models:
             low, high = models[0].angle_limits_deg
-            parts.append(f"{symbol} of {', '.join(m.name for m in models)} ({low:g}-{high:g})")
-    return "degrees: " + "; ".join(parts) + "; ignored by " + ", ".join(
-        m.name for m in COLON_MODELS.values() if m.angle == NO_ANGLE)
+            parts.append(f"{symbol} of {', '.join(m.name for m in models)} ({low:g}-{high:g} deg)")
+    ignored = [m.name for m in COLON_MODELS.values() if m.angle == NO_ANGLE]
+    return "; ".join(parts) + (f"; ignored by {', '.join(ignored)}" if ignored else "")
 
 
 # -- named scopes -------------------------------------------------------------------------------
