@@ -13,16 +13,16 @@ import time
 
 import numba
 
+from colonsim.catalog import meshed_diameters
 from colonsim.insertion.study.reference import SOURCE_RSJ_CM
 from colonsim.insertion.case.scenario import InsertionCase, run_insertion
-from colonsim.insertion.anatomy.scopes import MESHED_DIAMETERS
 
 TIMED = ("sdc", 36.0)
 
 
 def rsj_case(scope, diameter_mm):
     """The RSJ case of a source scope mesh (utc / pdc / sdc) at mu = 0."""
-    return InsertionCase(segment="rsj", scope=f"{MESHED_DIAMETERS[scope] * 1e3:g}", diameter_mm=diameter_mm)
+    return InsertionCase(segment="rsj", scope=f"{meshed_diameters()[scope] * 1e3:g}", diameter_mm=diameter_mm)
 
 
 def point(summary, name):

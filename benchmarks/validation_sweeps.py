@@ -18,9 +18,9 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from colonsim.catalog import scope_role
 from colonsim.errors import ColonsimError
 from colonsim.insertion.case.scenario import InsertionCase
-from colonsim.insertion.anatomy.scopes import scope_role
 from colonsim.insertion.study.sweep import TABLE, read_results
 from colonsim.insertion.study.sweep_spec import load_sweep, parse_sweep
 

@@ -4,9 +4,10 @@ The mapping is the project's reading of the source (docs/model.md, "Patients"), 
 value can be overridden by a JSON file or by giving the raw parameter:
 
 - sex -> the angle of the mobile part: alpha of the sigmoid (RSF) and beta of the transverse colon
-  (THF). The source: women have a lower sigmoid-descending fixation and longer, deeper transverse
-  colons, i.e. larger angles. Reading: male-like 0 deg, intermediate 30 deg, female-like 45 deg
-  (the three angles the source simulated). No effect on RSJ (fixed angulation) or fixed THF.
+  (THF), in the colon models whose catalog entry says so (``surrogate_angle``). The source: women
+  have a lower sigmoid-descending fixation and longer, deeper transverse colons, i.e. larger
+  angles. Reading: male-like 0 deg, intermediate 30 deg, female-like 45 deg (the three angles
+  the source simulated). No effect on RSJ (fixed angulation) or fixed THF.
 - age -> Coulomb friction between scope and wall (older patients, diverticular disease, more
   friction). Reading: young 0, middle 0.05, older 0.1 (the source's three values). The source
   also ties age to the fixed sigmoid angulation; the segments here keep that angulation fixed.
@@ -21,9 +22,8 @@ import json
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from colonsim.catalog import COLON_MODELS
 from colonsim.errors import ColonsimError
-
-ANGLE_SEGMENTS = ("rsf", "thf")
 
 
 @dataclass(frozen=True)
@@ -73,7 +73,8 @@ def patient_inputs(segment, sex=None, age=None, region=None, presets=None) -> di
     values = {}
     if sex is not None:
         angle = _lookup(presets.sex_angle_deg, sex, "sex")
-        if segment in ANGLE_SEGMENTS:
+        model = COLON_MODELS.get(segment)
+        if model is not None and model.surrogate_angle:
             values["angle_deg"] = angle
     if age is not None:
         values["friction"] = _lookup(presets.age_friction, age, "age group")

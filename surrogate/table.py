@@ -13,27 +13,23 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from colonsim import catalog
 from colonsim.errors import ColonsimError
 
-SEGMENTS = ("rsj", "rsf", "thf", "thf-fixed", "straight")
+# Derived from the catalog's columns (colonsim.catalog.COLUMNS), for the modules that import them.
+SEGMENTS = catalog.segment_names()
 # Continuous inputs a segment's model may depend on (those that vary in its runs).
-INPUTS = ("scope_diameter_mm", "diameter_mm", "angle_deg", "friction", "wall_thickness_mm")
-INPUT_LABELS = {"scope_diameter_mm": "scope diameter [mm]", "diameter_mm": "colon diameter [mm]",
-                "angle_deg": "angle alpha/beta [deg]", "friction": "friction coefficient",
-                "wall_thickness_mm": "wall thickness [mm]"}
+INPUTS = catalog.columns(catalog.INPUT, surrogate=(catalog.SURROGATE_INPUT,))
+INPUT_LABELS = {name: catalog.COLUMNS[name].label for name in INPUTS}
 # How the command line spells each input (for messages).
-INPUT_OPTIONS = {"scope_diameter_mm": "--scope", "diameter_mm": "--diameter", "angle_deg": "--angle",
-                 "friction": "--friction", "wall_thickness_mm": "--wall-thickness"}
-TARGETS = ("final_deformation_cm", "max_deformation_cm", "point_A_cm", "point_C_cm", "peak_contact_force_N",
-           "peak_push_force_N", "max_wall_stretch")
-TARGET_LABELS = {"final_deformation_cm": "final colon deformation [cm]", "max_deformation_cm": "maximum colon deformation [cm]",
-                 "point_A_cm": "deformation at point A [cm]", "point_B_cm": "deformation at point B [cm]",
-                 "point_C_cm": "deformation at point C [cm]", "peak_contact_force_N": "peak contact force [N]",
-                 "peak_push_force_N": "peak push force [N]", "max_wall_stretch": "maximum wall stretch"}
-# Columns that are neither inputs nor solver settings: identity and outputs of a run.
-NOT_SETTINGS = {"key", "status", "error", "wall_time_s", "timeseries_path", "finished_at", "git_commit", "segment", "scope",
-                "quasi_static", "quasi_static_literal", "quasi_static_without_imposed_sliding", "ended_by", "end_depth_cm",
-                "end_push_force_N", "end_contact_force_N", "simulated_time_s", "point_B_cm", *INPUTS, *TARGET_LABELS}
+INPUT_OPTIONS = {name: catalog.COLUMNS[name].option for name in INPUTS}
+TARGETS = catalog.columns(catalog.OUTPUT, surrogate=(catalog.DEFAULT_TARGET,))
+TARGET_LABELS = {name: catalog.COLUMNS[name].label
+                 for name in catalog.columns(catalog.OUTPUT, surrogate=(catalog.DEFAULT_TARGET, catalog.TARGET))}
+# Columns that are neither inputs nor solver settings: identity and outputs of a run, and the
+# name older tables gave today's quasi_static.
+NOT_SETTINGS = {name for name, column in catalog.COLUMNS.items() if column.kind != catalog.SETTING} | {
+    "quasi_static_without_imposed_sliding"}
 REQUIRED = ("status", "segment", "scope_diameter_mm")
 
 
@@ -56,14 +52,15 @@ def check_results(frame: pd.DataFrame, name="results table") -> pd.DataFrame:
     if missing:
         raise ColonsimError(f"{name} lacks the column(s) {', '.join(missing)}; is it a sweep's results table?")
     frame = frame.reset_index(drop=True)
+    segments = catalog.segment_names()
     blank = frame["segment"].isna() | (frame["segment"].astype(str).str.strip() == "")
     if blank.any():
         raise ColonsimError(f"{name}: {int(blank.sum())} row(s) have no segment ({_rows(frame, blank)}); fill it in "
-                            f"({', '.join(SEGMENTS)}) or remove those rows")
+                            f"({', '.join(segments)}) or remove those rows")
     frame["segment"] = frame["segment"].astype(str).str.strip().str.lower()
-    unknown = sorted(set(frame["segment"]) - set(SEGMENTS))
+    unknown = sorted(set(frame["segment"]) - set(segments))
     if unknown:
-        raise ColonsimError(f"{name} has unknown segment(s) {', '.join(unknown)}; expected {', '.join(SEGMENTS)}")
+        raise ColonsimError(f"{name} has unknown segment(s) {', '.join(unknown)}; expected {', '.join(segments)}")
     for column in (*INPUTS, *TARGET_LABELS):
         if column in frame.columns:
             frame[column] = numeric_column(frame, column, name)
@@ -155,28 +152,22 @@ def scope_diameters(runs: pd.DataFrame) -> dict:
     return {str(s).strip().lower(): float(d) for s, d in zip(pairs["scope"], pairs["scope_diameter_mm"])}
 
 
-# docs/model.md (the same numbers as colonsim.insertion.anatomy.scopes.NAMED_SCOPES, kept here so that reading a
-# surrogate does not import the solver); a sweep table's own scope column takes precedence.
-NAMED_SCOPES_MM = {"utc": 9.2, "pdc": 11.3, "sdc": 12.8}
-SMALL_CALIBER = ("utc", "pdc")
-STANDARD_SCOPE = "sdc"
+# The catalog's named scopes in mm (colonsim.catalog.NAMED_SCOPES); a sweep table's own scope
+# column takes precedence.
+NAMED_SCOPES_MM = {name: round(scope.diameter * 1e3, 6) for name, scope in catalog.NAMED_SCOPES.items()}
+STANDARD_SCOPE = catalog.standard_scope().name
 
 
 def scope_diameter_mm(spec, known=None) -> float:
-    """Outer diameter (mm) of a scope given by name (utc, pdc, sdc or one the sweep ran) or in mm."""
+    """Outer diameter (mm) of a scope given as :func:`colonsim.catalog.parse_scope` reads it, or by
+    a name the sweep ran (``known``: name -> mm, as the table recorded it)."""
     key = str(spec).strip().lower()
-    table = {**NAMED_SCOPES_MM, **(known or {})}
-    if key in table:
-        return table[key]
-    try:
-        value = float(key.removesuffix("mm"))
-    except ValueError:
-        raise ColonsimError(f"unknown scope {spec!r}; give {', '.join(sorted(table))} or an outer diameter in mm") from None
-    if not 3.0 <= value <= 20.0:
-        raise ColonsimError(f"scope diameter {value:g} mm is implausible (3-20 mm); give it in millimetres")
-    return value
+    if known and key in known:
+        return known[key]
+    # back to mm; 9 decimals keep every typed value exact
+    return round(catalog.parse_scope(spec)[1] * 1e3, 9)
 
 
 def target_unit(target) -> str:
-    """Unit of an output column, read from its name (``_cm`` -> cm, ``_N`` -> N, else none)."""
-    return {"cm": "cm", "N": "N"}.get(str(target).rsplit("_", 1)[-1], "")
+    """Unit of an output column (colonsim.catalog.COLUMNS; "" for none or an unknown column)."""
+    return catalog.column_unit(target)

@@ -8,7 +8,8 @@ from colonsim.errors import ColonsimError
 from colonsim.insertion.anatomy.centerline import FILLET_RADIUS, FLEXURE_RADIUS
 from colonsim.insertion.anatomy.colon_centerlines import EXIT_LENGTH, rsf_centerline, rsj_centerline, thf_centerline, thf_fixed_centerline
 from colonsim.insertion.anatomy.colon_geometry import tube_mesh
-from colonsim.insertion.anatomy.colon_segments import PAST_JUNCTION, colon_geometry
+from colonsim.catalog import PAST_JUNCTION
+from colonsim.insertion.anatomy.colon_segments import colon_geometry
 
 R, RF = FLEXURE_RADIUS, FILLET_RADIUS
 D, T, H = 0.036, 2e-3, 3e-3

@@ -12,7 +12,7 @@ import os
 import numpy as np
 import pytest
 
-from colonsim.insertion.anatomy.colon_segments import PAST_JUNCTION
+from colonsim.catalog import PAST_JUNCTION
 from colonsim.insertion.case.scenario import InsertionCase, run_insertion
 
 SIZE_MM = 3.0 if os.environ.get("COLONSIM_FULL") == "1" else 4.0

@@ -53,9 +53,10 @@ def test_undefined_targets_have_no_model_and_say_why(model):
 
 
 def test_named_scopes_agree_with_the_solver():
-    from colonsim.insertion.anatomy.scopes import NAMED_SCOPES
+    from colonsim.catalog import NAMED_SCOPES
+    from colonsim.insertion.anatomy.scopes import colonoscope
 
-    assert NAMED_SCOPES_MM == {k: round(v[1] * 1e3, 6) for k, v in NAMED_SCOPES.items()}
+    assert NAMED_SCOPES_MM == {k: round(colonoscope(k).diameter * 1e3, 6) for k in NAMED_SCOPES}
 
 
 def test_predictions_recover_the_synthetic_function(model):

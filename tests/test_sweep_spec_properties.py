@@ -13,7 +13,8 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from colonsim.errors import ColonsimError
-from colonsim.insertion.case.scenario import SEGMENTS, InsertionCase
+from colonsim.catalog import segment_names
+from colonsim.insertion.case.scenario import InsertionCase
 from colonsim.insertion.anatomy.scopes import colonoscope
 from colonsim.insertion.study.sweep_spec import SCOPE_DIAMETER, parse_sweep
 
@@ -27,7 +28,7 @@ NUMBER_KEYS = [k for k, v in DEFAULTS.items() if isinstance(v, float)] + [SCOPE_
 def plausible(key):
     """A value a user might mean for ``key``."""
     if key == "segment":
-        return st.sampled_from(SEGMENTS)
+        return st.sampled_from(segment_names())
     if key == "scope":
         return st.sampled_from(["utc", "pdc", "sdc", "10.5", 9.5])
     if key == "material":

@@ -1,23 +1,25 @@
-"""The colon models of the study as simulation-ready geometry (docs/model.md, "Colon models").
+"""The colon models of the catalog as simulation-ready geometry (docs/model.md, "Colon models").
 
-A thin layer over :mod:`colonsim.insertion.anatomy.centerline` (the centerlines, their fixed/mobile tags and their
-readings, in the builders' docstrings) and :mod:`colonsim.insertion.anatomy.colon_geometry` (the tube mesh). It
-adds what an insertion run needs from a model (**assumptions** where marked):
+A thin layer over :mod:`colonsim.insertion.anatomy.centerline` (the centerlines, their fixed/mobile
+tags and their readings, in the builders' docstrings) and
+:mod:`colonsim.insertion.anatomy.colon_geometry` (the tube mesh). Which models exist, and each
+one's angle, manoeuvre and end rule, is :data:`colonsim.catalog.COLON_MODELS`; this module holds
+their builders and applies those rules. It adds what an insertion run needs from a model
+(**assumptions** where marked):
 
 - the wall is meshed at its mid-surface, diameter D + t, because contact acts half a thickness
   inside the mid-surface;
 - every model continues past its last mobile piece into a fixed exit (``exit_length``, 10 cm by
   default), so the scope is held at both ends of the mobile part;
-- RSJ: the run ends when the tip is ``PAST_JUNCTION`` (2 cm) past the sigmoid's junction with
-  the fixed exit;
 - RSF: the sigmoid tilts by alpha towards the patient's left, away from the side the splenic
   flexure turns to (:func:`colonsim.insertion.anatomy.centerline.rsf_centerline`); alpha = 0 is one straight line;
 - THF / fixed THF: the scope enters the transverse colon directly;
-- RSF, THF: straightening ends where the mobile part ends (``straighten_depth``); while
-  straightening, each mobile node may only move along the straight piece it belongs to
-  (``mobile_axes``): the sigmoid, or each transverse arm, each with its half of the V-bottom
-  fillet. After it the push goes on until the scope's available length is used or the tip
-  reaches the model's far end (``end_depth`` = the centerline's length).
+- a model whose manoeuvre straightens ends straightening where the mobile part ends
+  (``straighten_depth``); while straightening, each mobile node may only move along the straight
+  piece it belongs to (``mobile_axes``): the sigmoid, or each transverse arm, each with its half of
+  the V-bottom fillet;
+- the end rule sets ``end_depth``: ``PAST_JUNCTION`` (2 cm) past the fixed end of the mobile piece
+  (RSJ), else the centerline's far end.
 
 :func:`colon_geometry` returns a :class:`ColonGeometry`. A straight tube (``"straight"``) is
 kept for sanity checks.
@@ -25,19 +27,20 @@ kept for sanity checks.
 
 from __future__ import annotations
 
+import importlib
 from dataclasses import dataclass, field
 
 import numpy as np
 
+from colonsim.catalog import PAST_JUNCTION, PAST_MOBILE_END, colon_model
 from colonsim.errors import ColonsimError
 from colonsim.insertion.anatomy.centerline import Straight
 from colonsim.insertion.anatomy.colon_centerlines import EXIT_LENGTH, FLEXURE_ANGLE_DEG, rsf_centerline, rsj_centerline, thf_centerline, thf_fixed_centerline
 from colonsim.insertion.anatomy.colon_geometry import tube_mesh
 from colonsim.insertion.engine.sheet_mesh import straight_tube
 
-ANGLE_LIMIT_DEG = 60.0  # RSF alpha and THF beta; the source used 0, 30, 45
 EXIT_LIMIT = 0.3  # m, fixed exit piece
-PAST_JUNCTION = 0.02  # m, an RSJ run ends when the tip is this far past the sigmoid's fixed end
+STRAIGHT_LENGTH = 0.20  # m, the straight sanity tube
 
 
 @dataclass
@@ -61,6 +64,8 @@ class ColonGeometry:
     end_depth: float | None = None
     # arc length where the mobile part ends (None: no mobile part)
     mobile_end: float | None = None
+    # the wall's tube mesh with its centerline (None for the straight tube)
+    tube: object = None
 
     def __post_init__(self):
         if self.end_depth is None:
@@ -108,20 +113,17 @@ def mobile_end(centerline):
     return float(ends[-1]) if ends else None
 
 
-def _geometry(name, centerline, diameter, element_size, wall_thickness, mobile_piece=None,
-              end_depth=None) -> ColonGeometry:
+def _tube_geometry(centerline, diameter, element_size, wall_thickness) -> ColonGeometry:
+    """The wall of ``centerline`` meshed at its mid-surface, with the mesh kept for the catalog's rules."""
     if 0.5 * diameter + wall_thickness >= centerline.min_radius:
         raise ColonsimError(f"a {diameter * 1e3:.0f} mm colon does not fit around a bend of radius "
                             f"{centerline.min_radius * 100:.0f} cm (the wall would fold); use a smaller --diameter")
     mesh = tube_mesh(centerline, diameter + wall_thickness, element_size)
-    axes = [] if mobile_piece is None else _mobile_axes(centerline, mesh, mobile_piece)
-    end_mobile = mobile_end(centerline)
-    return ColonGeometry(name, mesh.nodes, mesh.triangles, mesh.fixed & ~mesh.end_ring, mesh.mobile, mesh.end_ring,
+    return ColonGeometry("", mesh.nodes, mesh.triangles, mesh.fixed & ~mesh.end_ring, mesh.mobile, mesh.end_ring,
                          entry_point=centerline.position(0.0), entry_axis=centerline.tangent(0.0),
                          centerline_length=centerline.length,
                          centerline_points=lambda s: centerline.position(np.atleast_1d(s)),
-                         straighten_depth=end_mobile if mobile_piece is not None else None, mobile_axes=axes,
-                         end_depth=end_depth, mobile_end=end_mobile)
+                         mobile_end=mobile_end(centerline), tube=mesh)
 
 
 def straight_colon(length, diameter, element_size, wall_thickness, fixed_length=0.0) -> ColonGeometry:
@@ -137,9 +139,52 @@ def straight_colon(length, diameter, element_size, wall_thickness, fixed_length=
     )
 
 
+# The builders the catalog names (colonsim.catalog.ColonModel.builder): one signature, SI units.
+
+def rsj_geometry(diameter, angle_deg, element_size, wall_thickness, exit_length, flexure_angle_deg):
+    """RSJ (:func:`colonsim.insertion.anatomy.centerline.rsj_centerline`); no angle, no flexure."""
+    return _tube_geometry(rsj_centerline(exit_length=exit_length), diameter, element_size, wall_thickness)
+
+
+def rsf_geometry(diameter, angle_deg, element_size, wall_thickness, exit_length, flexure_angle_deg):
+    """RSF with the sigmoid tilted by alpha = ``angle_deg``."""
+    c = rsf_centerline(angle_deg, flexure_angle_deg=flexure_angle_deg, exit_length=exit_length)
+    return _tube_geometry(c, diameter, element_size, wall_thickness)
+
+
+def thf_geometry(diameter, angle_deg, element_size, wall_thickness, exit_length, flexure_angle_deg):
+    """THF with the transverse V at beta = ``angle_deg``."""
+    c = thf_centerline(angle_deg, flexure_angle_deg=flexure_angle_deg, exit_length=exit_length)
+    return _tube_geometry(c, diameter, element_size, wall_thickness)
+
+
+def thf_fixed_geometry(diameter, angle_deg, element_size, wall_thickness, exit_length, flexure_angle_deg):
+    """Fixed THF: the THF centerline with the transverse colon fixed too."""
+    c = thf_fixed_centerline(angle_deg, flexure_angle_deg=flexure_angle_deg, exit_length=exit_length)
+    return _tube_geometry(c, diameter, element_size, wall_thickness)
+
+
+def straight_geometry(diameter, angle_deg, element_size, wall_thickness, exit_length, flexure_angle_deg):
+    """The 20 cm straight tube, mobile throughout; no angle, no exit."""
+    return straight_colon(STRAIGHT_LENGTH, diameter, element_size, wall_thickness)
+
+
+def _builder(model):
+    module, _, function = model.builder.partition(":")
+    try:
+        return getattr(importlib.import_module(module), function)
+    except (ImportError, AttributeError):
+        raise ColonsimError(f"colon model {model.name!r}: builder {model.builder!r} not found; fix its catalog "
+                            "entry (colonsim/catalog.py)") from None
+
+
 def colon_geometry(segment, diameter, angle_deg, element_size, wall_thickness, exit_length=EXIT_LENGTH,
                    flexure_angle_deg=FLEXURE_ANGLE_DEG) -> ColonGeometry:
-    """The geometry of ``segment`` ("rsj", "rsf", "thf", "thf-fixed", or "straight").
+    """The geometry of the catalog's colon model ``segment`` (:data:`colonsim.catalog.COLON_MODELS`).
+
+    Builds it with the model's builder, then applies the model's rules: the mobile piece a
+    straighten-relax-push straightens (``mobile_axes``, ``straighten_depth``) and the end rule
+    (``end_depth``).
 
     Parameters
     ----------
@@ -147,29 +192,26 @@ def colon_geometry(segment, diameter, angle_deg, element_size, wall_thickness, e
     diameter, wall_thickness, element_size : float
         Lumen diameter D, wall thickness t and triangle size, m; the wall is meshed at D + t.
     angle_deg : float
-        RSF alpha or THF beta, 0-60 deg (ignored for RSJ and straight).
+        RSF alpha or THF beta, within the model's limits (ignored by models without an angle).
     exit_length : float
         m, the fixed straight every model continues into after its last mobile piece (10 cm).
     flexure_angle_deg : float
         Turn of the splenic (RSF) or hepatic (THF) flexure, deg (90).
     """
-    if segment == "straight":
-        return straight_colon(0.20, diameter, element_size, wall_thickness)
-    if segment not in ("rsj", "rsf", "thf", "thf-fixed"):
-        raise ColonsimError(f"{segment!r} is not a colon model; use rsj, rsf, thf, thf-fixed or straight")
-    if segment in ("rsf", "thf", "thf-fixed") and not (0.0 <= angle_deg <= ANGLE_LIMIT_DEG):
-        raise ColonsimError(f"--angle {angle_deg:g} deg is outside 0-{ANGLE_LIMIT_DEG:g} deg, the range this geometry "
-                            "builds (the source used 0, 30, 45)")
+    model = colon_model(segment)
+    model.check_angle(angle_deg)
     if not (np.isfinite(exit_length) and 0.0 <= exit_length <= EXIT_LIMIT):
         raise ColonsimError(f"exit length {exit_length * 1e3:g} mm must lie in 0-{EXIT_LIMIT * 1e3:g} mm")
-    if segment == "rsj":
-        c = rsj_centerline(exit_length=exit_length)
-        end = min(c.bounds("sigmoid")[1] + PAST_JUNCTION, c.length)
-        return _geometry("rsj", c, diameter, element_size, wall_thickness, end_depth=end)
-    if segment == "rsf":
-        c = rsf_centerline(angle_deg, flexure_angle_deg=flexure_angle_deg, exit_length=exit_length)
-        return _geometry("rsf", c, diameter, element_size, wall_thickness, mobile_piece="sigmoid")
-    build = thf_fixed_centerline if segment == "thf-fixed" else thf_centerline
-    c = build(angle_deg, flexure_angle_deg=flexure_angle_deg, exit_length=exit_length)
-    return _geometry(segment, c, diameter, element_size, wall_thickness,
-                     mobile_piece=None if segment == "thf-fixed" else "transverse")
+    geometry = _builder(model)(diameter, angle_deg, element_size, wall_thickness, exit_length, flexure_angle_deg)
+    geometry.name = model.name
+    if model.straightens or model.end_rule == PAST_MOBILE_END:
+        if geometry.tube is None:
+            raise ColonsimError(f"colon model {model.name!r}: its rules need a centerline mesh, and its builder "
+                                f"{model.builder!r} returns none; fix its catalog entry (colonsim/catalog.py)")
+        centerline = geometry.tube.centerline
+    if model.straightens:
+        geometry.mobile_axes = _mobile_axes(centerline, geometry.tube, model.mobile_piece)
+        geometry.straighten_depth = geometry.mobile_end
+    if model.end_rule == PAST_MOBILE_END:
+        geometry.end_depth = min(centerline.bounds(model.mobile_piece)[1] + PAST_JUNCTION, centerline.length)
+    return geometry

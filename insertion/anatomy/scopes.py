@@ -1,8 +1,7 @@
 """Colonoscopes of the study (docs/model.md, "Colonoscope"): named scopes or any diameter, as rods.
 
-The scope is a slender linear-elastic cylinder, E = 16 MPa (from the flexural rigidity of a
-3-point bending test), density 2944 kg/m^3, Poisson 0.3 (only used to report the shear modulus:
-a rod pushed axially without torsion does not need it), with a hemispherical tip.
+The scope is a slender linear-elastic cylinder with a hemispherical tip. The named scopes, their
+diameters and the material constants are :data:`colonsim.catalog.NAMED_SCOPES`.
 """
 
 from __future__ import annotations
@@ -10,32 +9,10 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-import numpy as np
-
+from colonsim.catalog import (NAMED_SCOPES, SCOPE_DENSITY, SCOPE_POISSON, SCOPE_YOUNGS_MODULUS, parse_scope,
+                              standard_scope)
 from colonsim.errors import ColonsimError
 from colonsim.insertion.engine.rod import Rod
-
-SCOPE_YOUNGS_MODULUS = 16e6  # Pa
-SCOPE_DENSITY = 2944.0  # kg/m^3
-SCOPE_POISSON = 0.3
-# Catalogue diameters, as the source's introduction and results name them; "small caliber" = UTC and PDC.
-NAMED_SCOPES = {
-    "utc": ("ultrathin colonoscope", 9.2e-3),
-    "pdc": ("pediatric colonoscope", 11.3e-3),
-    "sdc": ("standard colonoscope", 12.8e-3),
-}
-# The diameters the source's scope meshes had (its runs, and the runs that reproduce them).
-MESHED_DIAMETERS = {"utc": 9.2e-3, "pdc": 11.1e-3, "sdc": 13.3e-3}
-
-
-def scope_role(diameter_mm):
-    """``"utc"``, ``"pdc"`` or ``"sdc"`` for a catalogue or source-mesh diameter (mm), else None."""
-    for name, (_, catalogue) in NAMED_SCOPES.items():
-        if any(abs(diameter_mm - d * 1e3) < 0.05 for d in (catalogue, MESHED_DIAMETERS[name])):
-            return name
-    return None
-# Plausible range of an insertion tube's outer diameter, m: outside it a number is a unit slip.
-DIAMETER_RANGE = (3e-3, 20e-3)
 
 
 @dataclass(frozen=True)
@@ -60,7 +37,7 @@ class Colonoscope:
 
     @property
     def small_caliber(self):
-        return self.diameter < NAMED_SCOPES["sdc"][1] - 1e-9
+        return self.diameter < standard_scope().diameter - 1e-9
 
     def check_fits(self, colon_diameter):
         """Raise if the scope cannot pass through a colon of inner diameter ``colon_diameter`` (m)."""
@@ -82,18 +59,10 @@ class Colonoscope:
 
 
 def colonoscope(spec) -> Colonoscope:
-    """A scope from a name (``utc``, ``pdc``, ``sdc``, any case) or a diameter in mm (``"10.5"``, 10.5)."""
-    key = str(spec).strip().lower()
-    if key in NAMED_SCOPES:
-        return Colonoscope(key.upper(), NAMED_SCOPES[key][1])
-    try:
-        d_mm = float(key.removesuffix("mm"))
-    except ValueError:
-        raise ColonsimError(f"unknown scope {spec!r}; use utc, pdc, sdc or a diameter in mm such as 10.5") from None
-    d = d_mm * 1e-3
-    if not (np.isfinite(d) and DIAMETER_RANGE[0] <= d <= DIAMETER_RANGE[1]):
-        raise ColonsimError(
-            f"scope diameter {d_mm!r} mm is outside {DIAMETER_RANGE[0] * 1e3:g}-{DIAMETER_RANGE[1] * 1e3:g} mm; "
-            "give the outer diameter in mm"
-        )
-    return Colonoscope(f"{d_mm:g} mm", d)
+    """A scope from a spec :func:`colonsim.catalog.parse_scope` reads: a named scope (``utc``,
+    ``pdc``, ``sdc``, any case), with its catalog material, or a diameter in mm (``"10.5"``, 10.5)."""
+    name, diameter = parse_scope(spec)
+    named = NAMED_SCOPES.get(name.lower())
+    if named is None:
+        return Colonoscope(name, diameter)
+    return Colonoscope(name, diameter, named.youngs_modulus, named.density, named.poisson)

@@ -35,6 +35,7 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 
+from colonsim.catalog import CONTINUOUS_PUSH, colon_model
 from colonsim.errors import ColonsimError
 from colonsim.provenance import code_version
 from colonsim.insertion.anatomy.colon_segments import colon_geometry
@@ -48,9 +49,6 @@ from colonsim.insertion.engine.shell import Shell
 from colonsim.insertion.engine.constraints import FixedNodes, LineConstraint, PrescribedVelocity
 from colonsim.insertion.engine.solver import ExplicitSolver
 
-SEGMENTS = ("rsj", "rsf", "thf", "thf-fixed", "straight")
-# the source's scope lengths; "straight" is the sanity case (a 20 cm straight tube), not one of its models.
-SCOPE_LENGTH_M = {"rsj": 0.30, "rsf": 0.70, "thf": 0.50, "thf-fixed": 0.50, "straight": 0.30}
 COLON_DENSITY = 1040.0  # kg/m^3
 
 
@@ -60,7 +58,8 @@ class InsertionCase:
 
     Attributes
     ----------
-    segment : {"rsj", "rsf", "thf", "thf-fixed", "straight"}
+    segment : str
+        A colon model of :data:`colonsim.catalog.COLON_MODELS` (rsj, rsf, thf, thf-fixed, straight).
     scope : str
         ``utc``, ``pdc``, ``sdc`` or an outer diameter in mm.
     diameter_mm : float
@@ -115,8 +114,7 @@ class InsertionCase:
 
     def validate(self):
         """Raise :class:`ColonsimError` naming the first bad input and its fix."""
-        if self.segment not in SEGMENTS:
-            raise ColonsimError(f"unknown colon segment {self.segment!r}; use one of {', '.join(SEGMENTS)}")
+        colon_model(self.segment)
         checks = [
             ("diameter_mm", self.diameter_mm, 10.0, 80.0, "colon inner diameter in mm (23 or 36 in the source)"),
             ("wall_thickness_mm", self.wall_thickness_mm, 0.2, 10.0, "wall thickness in mm (2 assumed)"),
@@ -186,10 +184,11 @@ def build_insertion(case: InsertionCase) -> Insertion:
     entry = np.asarray(geometry.entry_point, dtype=float)
     axis = np.asarray(geometry.entry_axis, dtype=float)
     axis = axis / np.linalg.norm(axis)
-    length = SCOPE_LENGTH_M[case.segment]
+    anatomy = colon_model(case.segment)
+    length = anatomy.scope_length
     total_depth = length - case.sheath_reserve_mm * 1e-3
     tip_end = geometry.end_depth
-    if case.segment in ("rsj", "straight") and total_depth <= tip_end:
+    if anatomy.must_reach_end and total_depth <= tip_end:
         raise ColonsimError(f"a {length * 100:.0f} cm scope with {case.sheath_reserve_mm:g} mm kept in the sheath "
                             f"cannot reach {tip_end * 100:.1f} cm into the colon; shorten --exit-length")
     if geometry.straighten_depth is not None and total_depth <= geometry.straighten_depth:
@@ -197,7 +196,7 @@ def build_insertion(case: InsertionCase) -> Insertion:
                             f"{geometry.straighten_depth * 100:.1f} cm in; reduce sheath_reserve_mm")
     rod = scope.rod(start=entry - length * axis, direction=axis, length=length,
                     spacing=case.scope_spacing_mm * 1e-3)
-    if geometry.straighten_depth is None:
+    if anatomy.manoeuvre == CONTINUOUS_PUSH:
         push = continuous_push(total_depth, case.push_speed, case.ramp_s)
     else:
         push = straighten_relax_push(geometry.straighten_depth, total_depth, case.push_speed, case.ramp_s,
@@ -209,7 +208,7 @@ def build_insertion(case: InsertionCase) -> Insertion:
     held = np.flatnonzero(geometry.fixed | geometry.end_ring)
     constraints = [FixedNodes(shell, held)]
     mobile = np.flatnonzero(geometry.mobile & ~geometry.end_ring)
-    if geometry.straighten_depth is not None:
+    if anatomy.straightens:
         held_until = push.lateral_constraint_end
         # Lateral motion of the mobile part blocked while straightening ("birth and death"):
         # each mobile node may only move along the axis of the straight piece it belongs to.
@@ -295,7 +294,7 @@ def end_state(model: Insertion, ts, ended_by) -> dict:
     """Where and under which forces a run ended (``ended_by`` explained, depth, tip, forces)."""
     last = ts.iloc[-1]
     reason = ENDINGS[ended_by]
-    if ended_by == "length_used" and model.case.segment in ("rsj", "straight"):
+    if ended_by == "length_used" and colon_model(model.case.segment).must_reach_end:
         reason += " before the tip passed the fixed end"
     return {"reason": reason, "depth_cm": float(last["depth_m"] * 100), "tip_arc_cm": float(last["tip_arc_m"] * 100),
             "push_force_N": float(last["push_force_N"]), "contact_force_N": float(last["contact_force_N"])}

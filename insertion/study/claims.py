@@ -10,7 +10,7 @@ Each function takes the table of :mod:`colonsim.insertion.study.sweep` (one row 
   nothing is guessed from the runs that are there.
 
 A run's scope is UTC, PDC or SDC by name, or by its ``scope_diameter_mm`` when that is a
-catalogue or a source-mesh diameter (:func:`colonsim.insertion.anatomy.scopes.scope_role`), so the source's
+catalogue or a source-mesh diameter (:func:`colonsim.catalog.scope_role`), so the source's
 meshed scopes (9.2 / 11.1 / 13.3 mm) count as its UTC / PDC / SDC.
 
 The criterion of each claim is stated in ``ClaimResult.criterion``; the thresholds that make a
@@ -24,12 +24,13 @@ from dataclasses import dataclass, field
 import numpy as np
 import pandas as pd
 
+from colonsim.catalog import NAMED_SCOPES, scope_role
 from colonsim.errors import ColonsimError
-from colonsim.insertion.anatomy.scopes import scope_role
 
 REPRODUCED = "REPRODUCED"
 NOT_REPRODUCED = "NOT REPRODUCED"
 NOT_EVALUATED = "NOT EVALUATED"
+# The scopes the source's claims are about (not every scope the catalog may hold).
 SMALL_CALIBER = ("utc", "pdc")
 STANDARD = "sdc"
 FRICTIONS = (0.0, 0.05, 0.1)
@@ -66,7 +67,7 @@ class _Runs:
         names = table["scope"].astype(str).str.lower()
         if "scope_diameter_mm" in table:
             by_size = table["scope_diameter_mm"].astype(float).map(scope_role)
-            names = names.where(names.isin(("utc", "pdc", "sdc")), by_size)
+            names = names.where(names.isin(tuple(NAMED_SCOPES)), by_size)
         self._roles = names
 
     def value(self, column, segment, scope, **inputs):

@@ -34,6 +34,7 @@ from pathlib import Path
 
 import pandas as pd
 
+from colonsim import catalog
 from colonsim.errors import ColonsimError
 from colonsim.files import atomic_path, check_output_folder, write_json
 from colonsim.provenance import code_version
@@ -46,11 +47,9 @@ TABLE = "results.parquet"
 SWEEP_DOCUMENT = "sweep.json"
 LOCK = ".sweep.lock"
 DIED = "worker process died during this run (killed or out of memory)"
-IDENTITY = ("key", "status", "error", "wall_time_s", "timeseries_path", "finished_at", "git_commit")
-OUTPUTS = ("final_deformation_cm", "max_deformation_cm", "point_A_cm", "point_B_cm", "point_C_cm",
-           "peak_contact_force_N", "peak_push_force_N", "max_wall_stretch", "quasi_static",
-           "quasi_static_literal", "ended_by", "end_depth_cm", "end_push_force_N", "end_contact_force_N",
-           "simulated_time_s")
+# the table's columns, units and meanings: colonsim.catalog.COLUMNS
+IDENTITY = catalog.columns(catalog.PROVENANCE)
+OUTPUTS = catalog.columns(catalog.OUTPUT)
 
 
 def input_columns() -> list:

@@ -33,8 +33,8 @@ or, for a space-filling design crossed with a grid (2 x 20 runs)::
     diameter_mm = [20, 40]
     scope_diameter_mm = [9, 13]
 
-- ``scope`` takes ``utc``, ``pdc``, ``sdc`` or a diameter in mm; ``scope_diameter_mm`` (numbers)
-  is the same axis given as diameters. Give one of the two.
+- ``scope`` takes a named scope (:data:`colonsim.catalog.NAMED_SCOPES`) or a diameter in mm;
+  ``scope_diameter_mm`` (numbers) is the same axis given as diameters. Give one of the two.
 - ``material`` takes a material JSON path (relative paths are read from the TOML file's folder);
   ``""`` means the source's parameters.
 - With both ``[[grid]]`` and ``[lhs]``, every grid case is crossed with every hypercube sample.
@@ -61,6 +61,7 @@ from pathlib import Path
 
 import numpy as np
 
+from colonsim.catalog import NAMED_SCOPES
 from colonsim.errors import ColonsimError
 from colonsim.insertion.case.scenario import InsertionCase
 
@@ -207,7 +208,7 @@ def _coerce(name, value, where, base: Path | None):
     default = f.default
     if name == "scope":
         if isinstance(value, bool) or not isinstance(value, (str, int, float)):
-            raise ColonsimError(f"{where}: scope = {value!r}; give utc, pdc, sdc or a diameter in mm")
+            raise ColonsimError(f"{where}: scope = {value!r}; give {', '.join(NAMED_SCOPES)} or a diameter in mm")
         return "scope", (f"{_number(name, value, where):g}" if isinstance(value, (int, float)) else value.strip().lower())
     if name == "material":
         if not isinstance(value, str):
