@@ -11,7 +11,7 @@ import sys
 import warnings
 from pathlib import Path
 
-from colonsim import cli_surrogate, cli_sweep
+from colonsim import catalog, cli_surrogate, cli_sweep
 from colonsim.errors import ColonsimError, ColonsimWarning
 from colonsim.options import finite_float, output_folder, positive_int
 from colonsim.insertion.case.run_budget import DEFAULT_MAX_STEPS
@@ -92,10 +92,10 @@ def _add_insert(sub):
                                    "deformation, contact and push forces, tip motion and energies. Writes "
                                    "timeseries.csv, summary.json and insertion.png per scope, a comparison table "
                                    "and figure, and optional VTU files for ParaView.")
-    p.add_argument("--segment", default="rsj", help="rsj (default), rsf, thf, thf-fixed, or straight (sanity case)")
-    p.add_argument("--scope", nargs="+", default=["sdc"], help="utc, pdc, sdc or an outer diameter in mm; several allowed")
+    p.add_argument("--segment", default="rsj", help=f"colon model (default rsj): {catalog.segment_help()}")
+    p.add_argument("--scope", nargs="+", default=["sdc"], help=f"{catalog.scope_help()}; several allowed (default sdc)")
     p.add_argument("--diameter", type=finite_float, default=36.0, help="colon inner diameter, mm (default 36)")
-    p.add_argument("--angle", type=finite_float, default=0.0, help="alpha (RSF) or beta (THF), degrees (default 0)")
+    p.add_argument("--angle", type=finite_float, default=0.0, help=f"degrees (default 0): {catalog.angle_help()}")
     p.add_argument("--friction", type=finite_float, default=0.0, help="Coulomb friction scope/wall (default 0)")
     p.add_argument("--wall-thickness", type=finite_float, default=2.0, help="colon wall thickness, mm (default 2, an assumption)")
     p.add_argument("--element-size", type=finite_float, default=3.0, help="wall triangle size, mm (default 3)")

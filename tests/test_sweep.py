@@ -205,6 +205,7 @@ def test_a_folder_holds_one_sweep(tmp_path):
 
 
 def test_an_unreachable_scheduler_fails_before_anything_is_written(tmp_path):
+    pytest.importorskip("distributed")  # the cluster extra
     import socket
 
     from colonsim.errors import ColonsimError
