@@ -35,7 +35,8 @@ import numpy as np
 from colonsim.catalog import PAST_JUNCTION, PAST_MOBILE_END, colon_model
 from colonsim.errors import ColonsimError
 from colonsim.insertion.anatomy.centerline import Straight
-from colonsim.insertion.anatomy.colon_centerlines import EXIT_LENGTH, FLEXURE_ANGLE_DEG, rsf_centerline, rsj_centerline, thf_centerline, thf_fixed_centerline
+from colonsim.insertion.anatomy.colon_centerlines import (EXIT_LENGTH, FLEXURE_ANGLE_DEG, rsf_centerline, rsj_centerline,
+                                                          thf_centerline, thf_fixed_centerline)
 from colonsim.insertion.anatomy.colon_geometry import tube_mesh
 from colonsim.insertion.engine.sheet_mesh import straight_tube
 
