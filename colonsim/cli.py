@@ -128,7 +128,6 @@ class _Progress:
 def _format_result(r) -> str:
     from colonsim.identification.diagnostics import split_unidentified
     from colonsim.identification.report import small_strain
-    from colonsim.insertion.engine.material import solver_law_gap
 
     unc, ci = r.uncertainty, r.uncertainty.interval()
     lines = [f"{r.curve.name}: {r.model['model']}, law {r.model['law']}"]
@@ -162,9 +161,6 @@ def _format_result(r) -> str:
         lines.append(f"  clamped FE vs closed form at these parameters: {100 * mc['fe_over_closed_form_minus_1_min']:+.2f} % "
                      f"to {100 * mc['fe_over_closed_form_minus_1_max']:+.2f} % in force (end: {mc['force_end_fe_N']:.3f} vs "
                      f"{mc['force_end_closed_form_N']:.3f} N)")
-    gap = solver_law_gap(r.model["law"])
-    if gap:
-        lines.append(f"  note: {gap}; this material.json is for comparison only")
     return "\n".join(lines)
 
 
@@ -180,7 +176,7 @@ def _print_warnings(results):
 def run_calibration(args, out: Path) -> list:
     """Load the curves named by ``args``, calibrate, write results into ``out``; return the results."""
     from colonsim.files import check_output_folder
-    from colonsim.identification.laws import get_law
+    from colonsim.laws import get_law
     from colonsim.identification.pipeline import Budget
     from colonsim.identification.population import calibrate_curve, calibrate_specimens, population_summary, population_table, write_population
     from colonsim.identification.report import write_calibration
@@ -248,9 +244,9 @@ def _compare_laws(curve, options, per_eval, show, out: Path) -> list:
 
     from colonsim.identification.law_comparison import compare_laws, write_law_comparison
     from colonsim.identification.population import calibrate_curve
-    from colonsim.insertion.engine.material import SOLVER_LAWS
+    from colonsim.laws import LAWS
 
-    bar = _Progress(per_eval * len(SOLVER_LAWS), "eval", show)
+    bar = _Progress(per_eval * len(LAWS), "eval", show)
 
     def fit(law):
         return calibrate_curve(curve, progress=lambda stage, n, e1: bar.evaluation(f"{curve.name} {law}", stage, n, e1),
@@ -261,11 +257,9 @@ def _compare_laws(curve, options, per_eval, show, out: Path) -> list:
     finally:
         bar.close()
     paths = write_law_comparison(comparison, out)
-    shown = comparison.table.drop(columns=["fitted", "note"]).set_index("law")
+    shown = comparison.table.drop(columns=["note"]).set_index("law")
     with pd.option_context("display.width", 200, "display.max_columns", 30):
         print(shown.to_string(float_format=lambda v: f"{v:.4g}", na_rep="-"))
-    for law, why in comparison.left_out.items():
-        print(f"left out {law}: {why}")
     print(f"chosen: {comparison.chosen}, {comparison.reason}")
     print(_format_result(comparison.chosen_result))
     _print_warnings([comparison.chosen_result])
