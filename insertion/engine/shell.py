@@ -7,6 +7,11 @@ follower pressure, with lumped masses and a stable time step; docs/model.md for 
 All kernels are ``numba`` functions over raw arrays; the per-element buffers are summed onto nodes
 without races by :func:`colonsim.insertion.engine._scatter.gather`, or, for the internal forces,
 by one fused kernel that gives each thread its own nodal array.
+
+Numba's cache checks only a kernel's own file (measured): the fused kernel here compiles in code
+from shell_membrane.py, shell_hinges.py and colonsim/laws.py, so after editing those delete
+``insertion/engine/__pycache__`` or the old compiled code keeps running (a fresh checkout, as in
+CI, has no cache).
 """
 
 import math

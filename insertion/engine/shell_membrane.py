@@ -9,8 +9,8 @@ The law is any of :data:`colonsim.laws.LAWS`, passed to the kernels as its index
 parameter array: :func:`law_derivatives` compiles the laws' own energy functions and dispatches
 on the index (a jitted function as a kernel argument would be recompiled in every process).
 Adding a law: its function and entry in :mod:`colonsim.laws`, and its branch here. Numba's cache
-only watches this file: after editing a law in colonsim/laws.py, delete this folder's
-``__pycache__`` (tests/test_wall_laws.py fails on a stale compiled law).
+only watches each kernel's own file: after editing a law in colonsim/laws.py, delete this
+folder's ``__pycache__`` (tests/test_wall_laws.py fails on a stale compiled law).
 """
 
 import math
