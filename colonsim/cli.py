@@ -51,7 +51,7 @@ def _add_calibrate(sub):
                           "(default: fit the mean curve of all specimens, the source's way)")
     fit.add_argument("--law", help="mooney_rivlin_3 (default), mooney_rivlin_2, neo_hookean, yeoh")
     fit.add_argument("--compare-laws", action="store_true",
-                     help="fit every law the insertion solver runs, write laws.csv and laws.png, and material.json "
+                     help="fit every law (all of them run in the insertion solver), write laws.csv and laws.png, and material.json "
                           "for the law BIC chooses")
     fit.add_argument("--analytic", action="store_true",
                      help="fit the closed-form homogeneous uniaxial model instead of the clamped FE strip")

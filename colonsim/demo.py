@@ -174,7 +174,7 @@ def write_report(out: Path, calibration, insertions, sweep, model, recs, seconds
 
 def print_summary(calibration, insertions, model, recs):
     """The demo's findings in a few lines."""
-    from colonsim.identification.laws import get_law
+    from colonsim.laws import get_law
 
     _section("summary")
     mu0 = get_law(calibration.model["law"]).initial_shear_modulus(calibration.parameters)

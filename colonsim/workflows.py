@@ -114,7 +114,6 @@ class _Progress:
 def _format_result(r) -> str:
     from colonsim.identification.diagnostics import split_unidentified
     from colonsim.identification.report import small_strain
-    from colonsim.insertion.engine.material import solver_law_gap
 
     unc, ci = r.uncertainty, r.uncertainty.interval()
     lines = [f"{r.curve.name}: {r.model['model']}, law {r.model['law']}"]
@@ -148,9 +147,6 @@ def _format_result(r) -> str:
         lines.append(f"  clamped FE vs closed form at these parameters: {100 * mc['fe_over_closed_form_minus_1_min']:+.2f} % "
                      f"to {100 * mc['fe_over_closed_form_minus_1_max']:+.2f} % in force (end: {mc['force_end_fe_N']:.3f} vs "
                      f"{mc['force_end_closed_form_N']:.3f} N)")
-    gap = solver_law_gap(r.model["law"])
-    if gap:
-        lines.append(f"  note: {gap}; this material.json is for comparison only")
     return "\n".join(lines)
 
 
@@ -166,7 +162,7 @@ def _print_warnings(results):
 def calibrate(request: CalibrationRequest, out: Path) -> list:
     """Load the curves ``request`` names, calibrate, write results into ``out``; return the results."""
     from colonsim.files import check_output_folder
-    from colonsim.identification.laws import get_law
+    from colonsim.laws import get_law
     from colonsim.identification.pipeline import Budget
     from colonsim.identification.population import calibrate_curve, calibrate_specimens, population_summary, population_table, write_population
     from colonsim.identification.report import write_calibration
@@ -174,7 +170,7 @@ def calibrate(request: CalibrationRequest, out: Path) -> list:
 
     check_output_folder(out)
     if request.compare_laws and request.law is not None:
-        raise ColonsimError(f"--compare-laws fits every law the insertion solver runs; drop --law {request.law}")
+        raise ColonsimError(f"--compare-laws fits every law; drop --law {request.law}")
     if request.compare_laws and request.per_specimen:
         raise ColonsimError("--compare-laws fits one curve (or the mean curve); drop --per-specimen")
     law = request.law or "mooney_rivlin_3"
@@ -229,14 +225,14 @@ def calibrate(request: CalibrationRequest, out: Path) -> list:
 
 
 def _compare_laws(curve, options, per_eval, show, out: Path) -> list:
-    """``calibrate --compare-laws``: every law the solver runs on ``curve``, BIC chooses."""
+    """``calibrate --compare-laws``: every law of :data:`colonsim.laws.LAWS` on ``curve``, BIC chooses."""
     import pandas as pd
 
     from colonsim.identification.law_comparison import compare_laws, write_law_comparison
     from colonsim.identification.population import calibrate_curve
-    from colonsim.insertion.engine.material import SOLVER_LAWS
+    from colonsim.laws import LAWS
 
-    bar = _Progress(per_eval * len(SOLVER_LAWS), "eval", show)
+    bar = _Progress(per_eval * len(LAWS), "eval", show)
 
     def fit(law):
         return calibrate_curve(curve, progress=lambda stage, n, e1: bar.evaluation(f"{curve.name} {law}", stage, n, e1),
@@ -247,11 +243,9 @@ def _compare_laws(curve, options, per_eval, show, out: Path) -> list:
     finally:
         bar.close()
     paths = write_law_comparison(comparison, out)
-    shown = comparison.table.drop(columns=["fitted", "note"]).set_index("law")
+    shown = comparison.table.drop(columns=["note"]).set_index("law")
     with pd.option_context("display.width", 200, "display.max_columns", 30):
         print(shown.to_string(float_format=lambda v: f"{v:.4g}", na_rep="-"))
-    for law, why in comparison.left_out.items():
-        print(f"left out {law}: {why}")
     print(f"chosen: {comparison.chosen}, {comparison.reason}")
     print(_format_result(comparison.chosen_result))
     _print_warnings([comparison.chosen_result])

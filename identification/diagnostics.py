@@ -71,7 +71,7 @@ def shear_modulus_weights(law, n_parameters) -> np.ndarray:
 
 def shear_modulus(result) -> tuple[float, float]:
     """mu0 of a calibration and its standard deviation from the noise (Pa)."""
-    from colonsim.identification.laws import get_law
+    from colonsim.laws import get_law
 
     w = shear_modulus_weights(get_law(result.model["law"]), len(result.names))
     return float(w @ result.parameters), result.uncertainty.linear_combination_std(w)

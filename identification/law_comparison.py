@@ -1,6 +1,6 @@
-"""Fitting every law the insertion solver can run to one curve, and choosing one by BIC.
+"""Fitting every hyperelastic law to one curve, and choosing one by BIC.
 
-Each law of :data:`colonsim.insertion.engine.material.SOLVER_LAWS` goes through the same pipeline; the laws are
+Each law of :data:`colonsim.laws.LAWS` (all of them run in the insertion solver) goes through the same pipeline; the laws are
 ranked by the Bayesian information criterion of their least-squares fit on the simulation
 points (Gaussian errors of unknown variance: ``n ln(RSS / n) + k ln n``, AIC with ``2 k``). A
 law with more parameters must lower the residual enough to pay for them, so a simpler law that
@@ -9,7 +9,7 @@ fits as well wins. Differences are read on Kass and Raftery's scale (JASA 90, 19
 Layout of the output folder::
 
     material.json           the chosen law's, with a "law_selection" section saying why
-    laws.csv, laws.png      one row per law (left-out laws too, with the reason); all fits on the data
+    laws.csv, laws.png      one row per law; all fits on the data
     laws/<law>/             every fitted law's full calibration folder (material.json, history.csv, figures)
 """
 
@@ -24,9 +24,8 @@ from matplotlib.figure import Figure
 
 from colonsim.files import save_figure, write_csv, write_json
 from colonsim.identification.diagnostics import parameters_at_bounds, shear_modulus
-from colonsim.identification.laws import LAWS
 from colonsim.identification.report import material_document, write_calibration
-from colonsim.insertion.engine.material import SOLVER_LAWS, solver_law_gap
+from colonsim.laws import LAWS
 
 # Kass & Raftery's reading of a BIC difference (upper bound of each band).
 _EVIDENCE = ((2.0, "not worth more than a bare mention"), (6.0, "positive"), (10.0, "strong"), (np.inf, "very strong"))
@@ -50,7 +49,6 @@ class LawComparison:
     table: pd.DataFrame
     chosen: str
     reason: str
-    left_out: dict
 
     @property
     def chosen_result(self):
@@ -58,23 +56,22 @@ class LawComparison:
 
     def selection(self) -> dict:
         """The ``law_selection`` section of the chosen law's ``material.json``."""
-        rows = self.table[self.table["fitted"]]
+        t = self.table
         return {"criterion": "BIC (lowest wins): n ln(RSS/n) + k ln n on the simulation points",
                 "chosen": self.chosen, "reason": self.reason,
-                "bic": dict(zip(rows["law"], rows["bic"])), "aic": dict(zip(rows["law"], rows["aic"])),
-                "left_out": self.left_out, "table": "laws.csv"}
+                "bic": dict(zip(t["law"], t["bic"])), "aic": dict(zip(t["law"], t["aic"])),
+                "table": "laws.csv"}
 
 
-def compare_laws(calibrate_law, laws=SOLVER_LAWS) -> LawComparison:
+def compare_laws(calibrate_law, laws=tuple(LAWS)) -> LawComparison:
     """Fit each of ``laws`` with ``calibrate_law(law) -> CalibrationResult``; choose by BIC."""
     results = {law: calibrate_law(law) for law in laws}
-    left_out = {law: solver_law_gap(law) for law in LAWS if law not in laws}
     rows = []
     for law, r in results.items():
         n, k = r.fit["n_points"], len(r.names)
         aic, bic = information_criteria(r.fit["e1_N2"], n, k)
         mu0, mu0_sd = shear_modulus(r)
-        rows.append({"law": law, "fitted": True, "n_parameters": k, **{f"{p}_Pa": v for p, v in r.parameter_dict.items()},
+        rows.append({"law": law, "n_parameters": k, **{f"{p}_Pa": v for p, v in r.parameter_dict.items()},
                      "rms_N": r.fit["rms_N"], "rms_over_noise": r.fit["rms_over_noise"], "aic": aic, "bic": bic,
                      "mu0_Pa": mu0, "mu0_sd_Pa": mu0_sd, "note": "; ".join(parameters_at_bounds(r))})
     table = pd.DataFrame(rows)
@@ -87,16 +84,13 @@ def compare_laws(calibrate_law, laws=SOLVER_LAWS) -> LawComparison:
         reason += f"; next {order.loc[1, 'law']} at delta BIC {d:.1f} ({evidence(d)} evidence for {chosen})"
     if not results[chosen].fit["follows_curve"]:
         reason += (f"; but even {chosen} leaves {results[chosen].fit['rms_over_noise']:.1f} times the noise: "
-                   "no law the solver runs follows this curve")
+                   "no law fitted follows this curve")
     table["chosen"] = table["law"] == chosen
     table.loc[table["chosen"], "note"] = "; ".join(filter(None, [reason, *table.loc[table["chosen"], "note"]]))
     parameter_columns = [f"{p}_Pa" for law in LAWS.values() for p in law.parameter_names]
-    left = pd.DataFrame([{"law": law, "fitted": False, "n_parameters": len(LAWS[law].parameter_names), "chosen": False,
-                          "note": f"not fitted: {why}"} for law, why in left_out.items()])
-    table = pd.concat([table, left], ignore_index=True)
-    columns = ["law", "fitted", "chosen", "n_parameters", *dict.fromkeys(c for c in parameter_columns if c in table),
+    columns = ["law", "chosen", "n_parameters", *dict.fromkeys(c for c in parameter_columns if c in table),
                "rms_N", "rms_over_noise", "aic", "bic", "delta_bic", "mu0_Pa", "mu0_sd_Pa", "note"]
-    return LawComparison(results, table[columns], chosen, reason, left_out)
+    return LawComparison(results, table[columns], chosen, reason)
 
 
 def laws_figure(comparison: LawComparison) -> Figure:
@@ -117,7 +111,7 @@ def laws_figure(comparison: LawComparison) -> Figure:
         ax_r.plot(f["displacement_mm"], f["force_exp_N"] - f["force_fit_N"], "o-", ms=3, c=line.get_color())
     ax.set_ylabel("force [N]")
     ax.legend(fontsize=7)
-    ax.set_title(f"laws the insertion solver runs, fitted to {c.name}; BIC chooses {comparison.chosen}", fontsize=9)
+    ax.set_title(f"hyperelastic laws fitted to {c.name}; BIC chooses {comparison.chosen}", fontsize=9)
     ax_r.set_xlabel("grip displacement [mm]")
     ax_r.set_ylabel("residual [N]")
     return fig

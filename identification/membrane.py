@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from colonsim.identification.laws import Law
+from colonsim.laws import Law
 
 # d(cof F)/dF for 2x2 F: cof F = [F22, -F21, -F12, F11] is linear in F.
 _DCOF = np.zeros((4, 4))
@@ -24,13 +24,6 @@ _EYE4 = np.eye(4)
 
 def _cofactor(F):
     return np.stack([F[..., 3], -F[..., 2], -F[..., 1], F[..., 0]], axis=-1)
-
-
-def membrane_invariants(F):
-    """I1, I2 and det F of the plane-stress incompressible state, F flattened (..., 4)."""
-    s = np.einsum("...i,...i->...", F, F)
-    J = F[..., 0] * F[..., 3] - F[..., 1] * F[..., 2]
-    return s + J**-2, s / J**2 + J**2, J
 
 
 def membrane_stress(F, law: Law, params, tangent=True):

@@ -16,7 +16,7 @@ import pandas as pd
 from matplotlib.figure import Figure
 
 from colonsim.files import save_figure, write_csv, write_json
-from colonsim.identification.laws import get_law
+from colonsim.laws import get_law
 from colonsim.identification.objective import CurveObjective, make_model
 from colonsim.identification.pipeline import Budget, CalibrationResult, calibrate
 from colonsim.identification.report import MATERIAL_FORMAT, write_calibration

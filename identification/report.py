@@ -24,10 +24,9 @@ from matplotlib.figure import Figure
 from colonsim.files import save_figure, write_csv, write_json
 from colonsim.provenance import code_version
 from colonsim.identification.diagnostics import identification_words, misfit_warning, shear_modulus
-from colonsim.identification.laws import get_law
+from colonsim.laws import get_law
 from colonsim.identification.pipeline import CalibrationResult
 from colonsim.identification.testdata import source_records
-from colonsim.insertion.engine.material import solver_law_gap
 
 MATERIAL_FORMAT = "colonsim-material/1"
 _STAGE_COLOURS = {"initial": "k", "sensitivity": "tab:gray", "cma-es": "tab:blue", "nelder-mead": "tab:red"}
@@ -62,7 +61,6 @@ def material_document(result: CalibrationResult, level=0.95, selection=None) -> 
                        f"({result.model['model']}).",
         "units": "Pa",
         "parameters": result.parameter_dict,
-        "insertion_solver": solver_law_gap(law.name) or "runs this law",
         "small_strain": small_strain(result),
         "warnings": [warning] if warning else [],
         "uncertainty": {k: unc[k] for k in unc if k not in ("correlation", "covariance")},

@@ -22,7 +22,7 @@ from scipy.sparse.linalg import splu
 from skfem import Basis, ElementTriP1, ElementTriP2, MeshTri
 
 from colonsim.errors import ColonsimError
-from colonsim.identification.laws import get_law
+from colonsim.laws import get_law
 from colonsim.identification.membrane import membrane_stress
 
 
@@ -38,7 +38,7 @@ class ClampedStripModel:
     length, width, thickness : float
         Free length between the grips, width and wall thickness of the strip, m.
     law : Law or str
-        Hyperelastic law (:data:`colonsim.identification.laws.LAWS`), default 3-parameter Mooney-Rivlin.
+        Hyperelastic law (:data:`colonsim.laws.LAWS`), default 3-parameter Mooney-Rivlin.
     grips : {"clamped", "sliding"}
         Clamped grips forbid lateral motion at the gripped edges (the real test).
     n_length, n_width : int

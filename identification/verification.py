@@ -16,13 +16,13 @@ from pathlib import Path
 import numpy as np
 
 from colonsim.data import TENSILE_DIR
-from colonsim.identification.laws import get_law
+from colonsim.laws import get_law
 from colonsim.identification.membrane import membrane_stress
 from colonsim.identification.pipeline import Budget, CalibrationResult
 from colonsim.identification.population import calibrate_curve
 from colonsim.identification.specimen import ClampedStripModel
 from colonsim.identification.testdata import TensileCurve, read_manifest
-from colonsim.identification.uniaxial import homogeneous_force, nominal_stress
+from colonsim.identification.uniaxial import homogeneous_force
 
 # docs/model.md: the source's identified parameters (C10, C01, C11), Pa.
 REFERENCE = np.array([652.01, 42835.25, 219120.3])
@@ -65,7 +65,7 @@ def membrane_uniaxial_stress(stretches, params=REFERENCE, law="mooney_rivlin_3")
     F = np.zeros((lam.size, 4))
     F[:, 0], F[:, 3] = lam, lam**-0.5  # free lateral contraction of an incompressible sheet
     P = membrane_stress(F, get_law(law), params, tangent=False)
-    return P[:, 0], nominal_stress(lam, get_law(law), params), P[:, 3]
+    return P[:, 0], get_law(law).uniaxial_nominal_stress(lam, params), P[:, 3]
 
 
 def mesh_convergence(displacement=DISPLACEMENTS[-1], params=REFERENCE, strip=STRIP, fine=(24, 9)):

@@ -6,7 +6,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from colonsim.identification.laws import get_law
+from colonsim.laws import get_law
 from colonsim.identification.objective import CurveObjective, make_model
 from colonsim.identification.pipeline import Budget, calibrate
 from colonsim.identification.report import write_calibration
@@ -72,7 +72,7 @@ def test_result_files_feed_the_insertion_solver(specimen_fit, tmp_path):
     for p in paths.values():
         assert p.is_file() and p.stat().st_size > 0
     material = load_material(paths["material"])
-    assert material.C11 == pytest.approx(r.parameters[2])
+    assert material.named_parameters["C11"] == pytest.approx(r.parameters[2])
     doc = json.loads(paths["material"].read_text())
     assert doc["format"] == "colonsim-material/1"
     assert doc["correlation"]["names"] == list(NAMES)

@@ -1,4 +1,4 @@
-"""Reading the Mooney-Rivlin material file, and every way it can be wrong."""
+"""Reading the wall material file, and every way it can be wrong."""
 
 import json
 
@@ -6,7 +6,8 @@ import numpy as np
 import pytest
 
 from colonsim.errors import ColonsimError
-from colonsim.insertion.engine.material import REFERENCE_MATERIAL_PATH, MooneyRivlin, load_material
+from colonsim.insertion.engine.material import REFERENCE_MATERIAL_PATH, WallMaterial, load_material
+from colonsim.laws import LAWS
 
 
 def write(tmp_path, data, name="mat.json"):
@@ -24,7 +25,8 @@ def good(**overrides):
 
 def test_reference_file_holds_source_parameters():
     mat = load_material(REFERENCE_MATERIAL_PATH)
-    assert (mat.C10, mat.C01, mat.C11) == (652.01, 42835.25, 219120.3)
+    assert mat.law == "mooney_rivlin_3" and mat.parameters == (652.01, 42835.25, 219120.3)
+    assert mat.named_parameters == {"C10": 652.01, "C01": 42835.25, "C11": 219120.3}
     assert mat.mu0 == pytest.approx(2 * (652.01 + 42835.25), rel=1e-15)
     assert mat.E0 == pytest.approx(6 * (652.01 + 42835.25), rel=1e-15)
 
@@ -37,23 +39,35 @@ def test_reference_path_is_the_repo_data_file():
 
 def test_load_accepts_str_path(tmp_path):
     mat = load_material(str(write(tmp_path, good())))
-    assert isinstance(mat, MooneyRivlin)
+    assert isinstance(mat, WallMaterial)
 
 
 def test_material_is_frozen():
-    mat = MooneyRivlin(1.0, 2.0, 3.0)
+    mat = WallMaterial("mooney_rivlin_3", (1.0, 2.0, 3.0))
     with pytest.raises(AttributeError):
-        mat.C10 = 5.0
+        mat.parameters = (5.0, 2.0, 3.0)
+
+
+@pytest.mark.parametrize("law", sorted(LAWS))
+def test_every_law_loads(tmp_path, law):
+    """A material file of each law the calibration offers loads, with mu0 from the law."""
+    names = LAWS[law].parameter_names
+    params = {name: 1e4 * (i + 1) for i, name in enumerate(names)}
+    mat = load_material(write(tmp_path, good(law=law, parameters=params)))
+    assert mat.law == law and mat.parameters == tuple(params.values())
+    assert mat.mu0 == pytest.approx(LAWS[law].initial_shear_modulus(mat.parameters), rel=1e-15)
+    assert mat.E0 == pytest.approx(3.0 * mat.mu0, rel=1e-15)
 
 
 def test_uniaxial_stress_matches_numerical_derivative_of_energy():
     # Incompressible uniaxial: P = dW/dl with I1 = l^2 + 2/l, I2 = 2l + 1/l^2.
-    mat = MooneyRivlin(652.01, 42835.25, 219120.3)
+    C10, C01, C11 = 652.01, 42835.25, 219120.3
+    mat = WallMaterial("mooney_rivlin_3", (C10, C01, C11))
 
     def w(lam):
         i1 = lam**2 + 2 / lam
         i2 = 2 * lam + 1 / lam**2
-        return mat.C10 * (i1 - 3) + mat.C01 * (i2 - 3) + mat.C11 * (i1 - 3) * (i2 - 3)
+        return C10 * (i1 - 3) + C01 * (i2 - 3) + C11 * (i1 - 3) * (i2 - 3)
 
     for lam in (0.8, 1.1, 1.6):
         h = 1e-6
@@ -82,8 +96,18 @@ def test_not_an_object(tmp_path):
 
 
 def test_unknown_law(tmp_path):
-    with pytest.raises(ColonsimError, match="law 'yeoh'"):
-        load_material(write(tmp_path, good(law="yeoh")))
+    with pytest.raises(ColonsimError, match="law 'ogden'; use one of mooney_rivlin_3, .*yeoh"):
+        load_material(write(tmp_path, good(law="ogden")))
+
+
+def test_parameters_of_another_law(tmp_path):
+    with pytest.raises(ColonsimError, match="C01, C11 do not belong to law neo_hookean"):
+        load_material(write(tmp_path, good(law="neo_hookean", parameters={"C10": 1.0, "C01": 1.0, "C11": 1.0})))
+
+
+def test_wrong_parameter_count():
+    with pytest.raises(ColonsimError, match="law yeoh takes 3 parameter"):
+        WallMaterial("yeoh", (1.0, 2.0))
 
 
 def test_missing_law(tmp_path):
@@ -126,19 +150,19 @@ def test_non_numeric_parameter(tmp_path, value):
 
 def test_non_finite_parameter():
     with pytest.raises(ColonsimError, match="finite"):
-        MooneyRivlin(np.inf, 1.0, 1.0)
+        WallMaterial("mooney_rivlin_3", (np.inf, 1.0, 1.0))
     with pytest.raises(ColonsimError, match="finite"):
-        MooneyRivlin(np.nan, 1.0, 1.0)
+        WallMaterial("mooney_rivlin_3", (np.nan, 1.0, 1.0))
 
 
 def test_zero_small_strain_stiffness(tmp_path):
-    with pytest.raises(ColonsimError, match="C10 \\+ C01"):
+    with pytest.raises(ColonsimError, match="small-strain shear modulus mu0 = 0.0 Pa must be > 0"):
         load_material(write(tmp_path, good(parameters={"C10": 0.0, "C01": 0.0, "C11": 3.0})))
 
 
 def test_integer_parameters_become_floats(tmp_path):
     mat = load_material(write(tmp_path, good(parameters={"C10": 1000, "C01": 2000, "C11": 0})))
-    assert isinstance(mat.C10, float) and mat.E0 == 18000.0
+    assert all(isinstance(v, float) for v in mat.parameters) and mat.E0 == 18000.0
 
 
 def test_a_wall_softer_than_any_tissue_is_loaded_with_a_warning(tmp_path, capsys):

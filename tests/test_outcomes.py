@@ -46,7 +46,7 @@ def test_quasi_static_fraction():
 
 
 def test_principal_stretch_of_a_stretched_and_rotated_triangle():
-    from colonsim.insertion.engine.shell import reference_frames
+    from colonsim.insertion.engine.shell_membrane import reference_frames
 
     nodes = np.array([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]])
     tri = np.array([[0, 1, 2]])

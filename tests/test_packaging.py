@@ -5,6 +5,7 @@ from outside the checkout is the release check in docs/architecture.md; building
 the part that fails when a package folder or a data file is left out of pyproject.toml.)
 """
 
+import shutil
 import subprocess
 import sys
 import zipfile
@@ -13,12 +14,23 @@ from pathlib import Path
 import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
+if sys.version_info >= (3, 11):
+    import tomllib
+else:  # pragma: no cover - Python 3.10
+    import tomli as tomllib
+PACKAGE_FOLDERS = set(tomllib.loads((ROOT / "pyproject.toml").read_text())["tool"]["setuptools"]["package-dir"].values())
 
 
 @pytest.fixture(scope="module")
 def wheel_names(tmp_path_factory):
+    # built from a copy: setuptools leaves a build/ folder in the tree it builds
+    source = tmp_path_factory.mktemp("source")
+    for name in ("pyproject.toml", "README.md"):
+        shutil.copy(ROOT / name, source / name)
+    for folder in PACKAGE_FOLDERS:
+        shutil.copytree(ROOT / folder, source / folder, ignore=shutil.ignore_patterns("__pycache__"))
     out = tmp_path_factory.mktemp("wheel")
-    done = subprocess.run([sys.executable, "-m", "pip", "wheel", "--no-deps", "--quiet", "-w", str(out), str(ROOT)],
+    done = subprocess.run([sys.executable, "-m", "pip", "wheel", "--no-deps", "--quiet", "-w", str(out), str(source)],
                           capture_output=True, text=True)
     if done.returncode != 0:
         pytest.fail(f"building the wheel failed: {done.stderr.strip()[-2000:]}")

@@ -7,6 +7,7 @@ D = E0 t^3 / 9 (nu = 1/2), whatever the cylinder's direction relative to the mes
 
 import numpy as np
 import pytest
+from shell_reference import bending_forces
 
 from colonsim.insertion.engine.sheet_mesh import straight_tube
 from colonsim.insertion.engine.shell import Shell
@@ -19,7 +20,7 @@ THICKNESS = WALL_T
 
 def _bending(shell, x):
     f = np.zeros_like(x)
-    return shell.bending_forces(x, f), f
+    return bending_forces(shell, x, f), f
 
 
 def test_bending_stiffness_is_plate_value():
@@ -32,7 +33,7 @@ def test_cylindrical_bending_energy_matches_plate_theory(angle_deg, radius):
     """Interior hinge energy density = D / (2 R^2) within 1 %.
 
     On an exactly equilateral mesh the leading-order density is exact and direction independent
-    (derivation in insertion/shell.py); the residual (measured <= 0.6 %) comes from the sheet's
+    (derivation in insertion/engine/shell_hinges.py); the residual (measured <= 0.6 %) comes from the sheet's
     rows being spaced 0.4 % off the equilateral value (rounding of the row count) and from
     O((h/R)^2) = 1 % at R = 3 cm, whose effect on the angle-squared sum is far smaller.
     """
@@ -58,7 +59,7 @@ def test_whole_sheet_cylinder_energy():
 
 def test_spherical_bending_shows_documented_hinge_poisson_ratio():
     """A shallow spherical cap (R = 0.3 m) gives the hinge model's own value (2/3) D / R^2 per area
-    (intrinsic Poisson ratio -1/3, documented in insertion/shell.py) within 1 %; measured 0.1 %."""
+    (intrinsic Poisson ratio -1/3, documented in insertion/engine/shell_hinges.py) within 1 %; measured 0.1 %."""
     c = sphere_bending(0.3)
     assert c.measured == pytest.approx(c.analytic, rel=1e-2)
 

@@ -4,10 +4,10 @@ flat triangulated sheet reproduces the closed-form incompressible Mooney-Rivlin 
 import numpy as np
 import pytest
 
+from shell_reference import membrane_forces
+
 from colonsim.errors import ColonsimError
-from colonsim.identification.laws import get_law
-from colonsim.identification.uniaxial import nominal_stress
-from colonsim.insertion.engine.material import MooneyRivlin, REFERENCE_MATERIAL_PATH, load_material
+from colonsim.insertion.engine.material import REFERENCE_MATERIAL_PATH, WallMaterial, load_material
 from colonsim.insertion.engine.sheet_mesh import flat_sheet
 from colonsim.insertion.engine.shell import Shell
 from colonsim.insertion.engine.statics import minimize_energy
@@ -15,8 +15,8 @@ from colonsim.insertion.engine.statics import minimize_energy
 REFERENCE = load_material(REFERENCE_MATERIAL_PATH)
 MATERIALS = {
     "reference": REFERENCE,
-    "neo_hookean": MooneyRivlin(20e3, 0.0, 0.0),
-    "mooney_rivlin_2": MooneyRivlin(15e3, 5e3, 0.0),
+    "neo_hookean": WallMaterial("neo_hookean", (20e3,)),
+    "mooney_rivlin_2": WallMaterial("mooney_rivlin_2", (15e3, 5e3)),
 }
 LENGTH, WIDTH, THICKNESS, H = 0.10, 0.025, 0.002, 0.005
 
@@ -28,7 +28,7 @@ def _sheet(material):
 
 def _membrane(shell, x):
     f = np.zeros_like(x)
-    energy = shell.membrane_forces(x, f)
+    energy = membrane_forces(shell, x, f)
     return energy, f
 
 
@@ -59,14 +59,13 @@ def test_uniaxial_stretch_matches_closed_form(name, rotated):
 
     Constant-strain triangles represent a homogeneous deformation exactly, so the closed form must
     hold to round-off: the axial grip force equals P(l) W t with P from
-    ``colonsim.identification.uniaxial.nominal_stress`` (independent code), every node off the grips is in
+    ``colonsim.laws.Law.uniaxial_nominal_stress`` (independent code), every node off the grips is in
     equilibrium, and no node carries a lateral force (plane stress, free lateral contraction), all
     to 1e-9 of the grip force; the energy equals W(l) L W t. ``rotated`` puts the sheet at an
     arbitrary orientation in space (frame invariance).
     """
     material = MATERIALS[name]
-    law = get_law("mooney_rivlin_3")
-    params = np.array([material.C10, material.C01, material.C11])
+    law, params = material.law_model, material.parameters
     shell = _sheet(material)
     q = _rotation(7) if rotated else np.eye(3)
     shell_r = Shell(shell.x0 @ q.T, shell.triangles, THICKNESS, material)
@@ -78,7 +77,7 @@ def test_uniaxial_stretch_matches_closed_form(name, rotated):
         energy, f = _membrane(shell_r, np.ascontiguousarray(x @ q.T))
         f = f @ q  # back to the sheet's own axes
         force = -f[grip, 0].sum()
-        expected = nominal_stress(stretch, law, params) * WIDTH * THICKNESS
+        expected = law.uniaxial_nominal_stress(stretch, params) * WIDTH * THICKNESS
         assert force == pytest.approx(expected, rel=1e-9)
         assert np.max(np.abs(f[others])) < 1e-9 * force
         assert np.max(np.abs(f[:, 1:])) < 1e-9 * force
@@ -127,11 +126,10 @@ def test_free_lateral_contraction_found_by_static_solve(serial_kernels):
     free[np.argmin(shell.x0[:, 0] + shell.x0[:, 1]), 1] = False  # no rigid sliding across
     start = shell.x0.copy()
     start[:, 0] = shell.x0[:, 0] * stretch
-    expected = nominal_stress(stretch, get_law("mooney_rivlin_3"), [material.C10, material.C01, material.C11])
-    expected *= WIDTH * THICKNESS
-    x, _ = minimize_energy(start, free, shell.membrane_forces, force_tol=1e-7 * expected)
+    expected = material.uniaxial_nominal_stress(stretch) * WIDTH * THICKNESS
+    x, _ = minimize_energy(start, free, lambda y, f: membrane_forces(shell, y, f), force_tol=1e-7 * expected)
     assert np.ptp(x[:, 1]) / WIDTH == pytest.approx(stretch**-0.5, rel=1e-5)
     assert np.allclose(x[:, 0], shell.x0[:, 0] * stretch, rtol=0, atol=1e-5 * LENGTH)
     f = np.zeros_like(x)
-    shell.membrane_forces(x, f)
+    membrane_forces(shell, x, f)
     assert -f[grip, 0].sum() == pytest.approx(expected, rel=1e-5)

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from colonsim.errors import ColonsimError
-from colonsim.identification.laws import get_law
+from colonsim.laws import get_law
 from colonsim.identification.membrane import membrane_stress
 from colonsim.identification.specimen import ClampedStripModel, FEConvergenceError
 from colonsim.identification.verification import (DISPLACEMENTS, REFERENCE, STRIP, membrane_uniaxial_stress, mesh_convergence,

@@ -343,6 +343,6 @@ def summarize(model: Insertion, ts, wall_s, build_s) -> dict:
         "wall_time_s": float(wall_s),
         "build_time_s": float(build_s),
         "mesh": {**g.summary(), "scope_nodes": int(model.rod.n_nodes), "hinges": int(len(model.shell.hinges))},
-        "material": {"C10": model.shell.material.C10, "C01": model.shell.material.C01, "C11": model.shell.material.C11,
+        "material": {"law": model.shell.material.law, **model.shell.material.named_parameters,
                      "file": model.case.material or str(REFERENCE_MATERIAL_PATH)},
     }

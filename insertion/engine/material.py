@@ -1,9 +1,9 @@
-"""Colon wall material: the incompressible three-parameter Mooney-Rivlin law read from JSON.
+"""Colon wall material: an incompressible hyperelastic law of :mod:`colonsim.laws` read from JSON.
 
-The calibration workflow writes a material file (``"law": "mooney_rivlin_3"`` or one of the
-other :data:`SOLVER_LAWS`, parameters in Pa); the insertion model reads it here. A reference copy
-holding the source's identified parameters ships with the repository
-(:data:`REFERENCE_MATERIAL_PATH`).
+The calibration workflow writes a material file (``"law"``: any of :data:`colonsim.laws.LAWS`,
+parameters in Pa); the insertion model reads it here and its shell runs that law. A reference copy
+holding the source's identified three-parameter Mooney-Rivlin parameters ships with the
+repository (:data:`REFERENCE_MATERIAL_PATH`).
 """
 
 import json
@@ -14,14 +14,8 @@ from pathlib import Path
 
 from colonsim.data import REFERENCE_MATERIAL_PATH
 from colonsim.errors import ColonsimError, ColonsimWarning
-from colonsim.identification.laws import get_law
+from colonsim.laws import LAWS, Law, get_law
 
-LAW = "mooney_rivlin_3"
-PARAMETER_NAMES = ("C10", "C01", "C11")
-# The calibrated laws the wall model runs. It is the three-parameter Mooney-Rivlin, so a law runs
-# when it is a special case of it: the parameters it lacks are zero. ``colonsim calibrate
-# --compare-laws`` fits exactly these; a law of another form (yeoh) needs its own wall model first.
-SOLVER_LAWS = ("mooney_rivlin_3", "mooney_rivlin_2", "neo_hookean")
 # Small-strain shear modulus below which a wall is softer than any soft tissue: the softest
 # (brain, fat) are near 1 kPa, the reference colon wall 87 kPa. Below this, parameters were most
 # likely given in the wrong unit.
@@ -32,83 +26,78 @@ class SoftWallWarning(ColonsimWarning):
     """A wall material softer than any soft tissue (probably parameters in the wrong unit)."""
 
 
-def solver_law_gap(law):
-    """Why the insertion solver cannot run ``law`` (None when it can)."""
-    if law in SOLVER_LAWS:
-        return None
-    return (f"the insertion solver's wall law is {LAW}; {law} is not a special case of it (the solver runs "
-            f"{', '.join(SOLVER_LAWS)})")
-
-
 @dataclass(frozen=True)
-class MooneyRivlin:
-    """Incompressible Mooney-Rivlin law W = C10 (I1-3) + C01 (I2-3) + C11 (I1-3)(I2-3).
+class WallMaterial:
+    """An incompressible hyperelastic wall material: a registered law and its parameters.
 
     Parameters
     ----------
-    C10, C01, C11 : float
-        Material constants, Pa. All non-negative, with C10 + C01 > 0.
+    law : str
+        Name of the law, one of :data:`colonsim.laws.LAWS`.
+    parameters : sequence of float
+        The law's parameters in the order of its ``parameter_names``, Pa. All finite and
+        non-negative (the calibration's bounds), with a positive small-strain shear modulus.
     """
 
-    C10: float
-    C01: float
-    C11: float
+    law: str
+    parameters: tuple[float, ...]
 
     def __post_init__(self):
-        for name in PARAMETER_NAMES:
-            value = getattr(self, name)
+        model = get_law(self.law)
+        names = model.parameter_names
+        values = tuple(self.parameters)
+        if len(values) != len(names):
+            raise ColonsimError(f"law {self.law} takes {len(names)} parameter(s) ({', '.join(names)}), got "
+                                f"{len(values)}; fix the material parameters.")
+        for name, value in zip(names, values):
             if isinstance(value, bool) or not isinstance(value, (int, float)):
-                raise ColonsimError(
-                    f"Mooney-Rivlin parameter {name} must be a number in Pa, got {value!r}; "
-                    "fix the material parameters."
-                )
+                raise ColonsimError(f"{self.law} parameter {name} must be a number in Pa, got {value!r}; "
+                                    "fix the material parameters.")
             if not math.isfinite(value) or value < 0.0:
-                raise ColonsimError(
-                    f"Mooney-Rivlin parameter {name} = {value!r} Pa must be finite and >= 0; "
-                    "fix the material parameters."
-                )
-            object.__setattr__(self, name, float(value))
-        if self.C10 + self.C01 <= 0.0:
-            raise ColonsimError(
-                f"Mooney-Rivlin C10 + C01 = {self.C10 + self.C01!r} Pa must be > 0 (zero "
-                "small-strain stiffness); fix the material parameters."
-            )
+                raise ColonsimError(f"{self.law} parameter {name} = {value!r} Pa must be finite and >= 0; "
+                                    "fix the material parameters.")
+        object.__setattr__(self, "parameters", tuple(float(v) for v in values))
+        if not self.mu0 > 0.0:
+            raise ColonsimError(f"{self.law} small-strain shear modulus mu0 = {self.mu0!r} Pa must be > 0 (zero "
+                                "small-strain stiffness); fix the material parameters.")
+
+    @property
+    def law_model(self) -> Law:
+        """The law's registry entry (energy function, parameter names, kernel index)."""
+        return LAWS[self.law]
+
+    @property
+    def named_parameters(self) -> dict:
+        """``{name: value}`` in Pa, as a material file holds them."""
+        return dict(zip(self.law_model.parameter_names, self.parameters))
 
     @property
     def mu0(self):
-        """Small-strain shear modulus 2 (C10 + C01), Pa."""
-        return 2.0 * (self.C10 + self.C01)
+        """Small-strain shear modulus 2 (W1 + W2) at rest, Pa."""
+        return self.law_model.initial_shear_modulus(self.parameters)
 
     @property
     def E0(self):
-        """Small-strain Young's modulus 6 (C10 + C01), Pa (incompressible)."""
-        return 6.0 * (self.C10 + self.C01)
+        """Small-strain Young's modulus 3 mu0, Pa (incompressible)."""
+        return 3.0 * self.mu0
 
     def uniaxial_nominal_stress(self, stretch):
         """Homogeneous uniaxial nominal (first Piola) stress at stretch ``stretch``, Pa."""
-        lam = stretch
-        i1 = lam**2 + 2.0 / lam
-        i2 = 2.0 * lam + 1.0 / lam**2
-        return (
-            2.0
-            * (lam - lam**-2)
-            * (self.C10 + self.C11 * (i2 - 3.0) + (self.C01 + self.C11 * (i1 - 3.0)) / lam)
-        )
+        return self.law_model.uniaxial_nominal_stress(stretch, self.parameters)
 
 
 def load_material(path):
-    """Read a material file of one of the :data:`SOLVER_LAWS`.
+    """Read a material file of any law of :data:`colonsim.laws.LAWS`.
 
     Parameters
     ----------
     path : str or Path
         JSON file with ``"law"`` (e.g. ``"mooney_rivlin_3"``), ``"units": "Pa"`` and
-        ``"parameters"`` of that law (``{"C10": .., "C01": .., "C11": ..}``); the Mooney-Rivlin
-        parameters a simpler law lacks are zero.
+        ``"parameters"`` of that law by name (``{"C10": .., "C01": .., "C11": ..}``).
 
     Returns
     -------
-    MooneyRivlin
+    WallMaterial
 
     Raises
     ------
@@ -133,12 +122,11 @@ def load_material(path):
             "fix or regenerate the file."
         )
     law = data.get("law")
-    if law not in SOLVER_LAWS:
+    if not isinstance(law, str) or law not in LAWS:
         raise ColonsimError(
-            f"material file {path} has law {law!r}; the insertion solver runs {', '.join(SOLVER_LAWS)}: "
-            "recalibrate with one of them."
+            f"material file {path} has law {law!r}; use one of {', '.join(LAWS)} (the laws the calibration fits)."
         )
-    names = get_law(law).parameter_names
+    names = LAWS[law].parameter_names
     units = data.get("units", "Pa")
     if units != "Pa":
         raise ColonsimError(
@@ -164,11 +152,11 @@ def load_material(path):
             f"give only {', '.join(names)} or change the law."
         )
     try:
-        material = MooneyRivlin(*(params.get(name, 0.0) for name in PARAMETER_NAMES))
+        material = WallMaterial(law, tuple(params[name] for name in names))
     except ColonsimError as exc:
         raise ColonsimError(f"material file {path}: {exc}") from None
     if material.mu0 < SOFTEST_TISSUE_MU0_PA:
-        warnings.warn(f"material file {path}: small-strain shear modulus 2 (C10 + C01) = {material.mu0:.3g} Pa is "
+        warnings.warn(f"material file {path}: small-strain shear modulus mu0 = {material.mu0:.3g} Pa is "
                       f"softer than any soft tissue (the softest, brain and fat, are near 1 kPa); are the parameters "
                       "in Pa?", SoftWallWarning)
     return material

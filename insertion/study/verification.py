@@ -20,8 +20,9 @@ from colonsim.insertion.engine.contact import RodShellContact
 from colonsim.insertion.engine.material import REFERENCE_MATERIAL_PATH, load_material
 from colonsim.insertion.engine.rod import Rod
 from colonsim.insertion.engine.sheet_mesh import flat_sheet, straight_tube
-from colonsim.insertion.engine.shell import Shell, dihedral_angles
 from colonsim.insertion.engine.constraints import FixedNodes, LineConstraint, NodalLoad, PrescribedVelocity
+from colonsim.insertion.engine.shell import Shell
+from colonsim.insertion.engine.shell_hinges import dihedral_angles
 from colonsim.insertion.engine.solver import ExplicitSolver
 from colonsim.insertion.engine.statics import minimize_energy
 
@@ -192,9 +193,9 @@ def thin_wall_pressure(stretch, material=None, radius=TUBE_RADIUS, thickness=WAL
 
         p(l) = (2 t / R) (1 - l^-4) [C10 + C01 + 2 C11 (l^2 + l^-2 - 2)]
     """
-    c = material or reference_material()
+    c = (material or reference_material()).named_parameters
     l = np.asarray(stretch, dtype=float)
-    return 2.0 * thickness / radius * (1.0 - l**-4) * (c.C10 + c.C01 + 2.0 * c.C11 * (l**2 + l**-2 - 2.0))
+    return 2.0 * thickness / radius * (1.0 - l**-4) * (c["C10"] + c["C01"] + 2.0 * c["C11"] * (l**2 + l**-2 - 2.0))
 
 
 def inflation_tube(length, material=None):

@@ -1,0 +1,84 @@
+"""Verification of the shell for every wall law: uniaxial tension and inflation in closed form.
+
+Each law of :data:`colonsim.laws.LAWS` runs in the shell kernels through its own energy function,
+so each is checked on the two homogeneous states whose answers follow from the law alone
+(docs/model.md): a flat patch in uniaxial tension against the law's nominal stress
+P = 2 (l - l^-2) (W1 + W2 / l), and a plane-strain tube section inflated by the thin-wall pressure
+p(l) = (2 t / R) (1 - l^-4) (W1 + W2) at I1 = I2 = l^2 + 1 + l^-2 (derivation in
+tests/test_shell_inflation.py). The tolerances and their reasons are in tests/test_wall_laws.py.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from colonsim.insertion.engine.material import WallMaterial
+from colonsim.insertion.engine.sheet_mesh import flat_sheet
+from colonsim.insertion.engine.shell import Shell
+from colonsim.insertion.engine.statics import minimize_energy
+from colonsim.insertion.study.verification import (TUBE_H, TUBE_RADIUS, WALL_T, Comparison, _closed_volume,
+                                                   inflation_tube)
+
+# One material per law, all near the reference wall's small-strain shear modulus (87 kPa), with
+# the stiffening terms large enough to double the stress of the linear part at the checked stretches.
+CHECK_MATERIALS = {
+    "mooney_rivlin_3": WallMaterial("mooney_rivlin_3", (652.01, 42835.25, 219120.3)),
+    "mooney_rivlin_2": WallMaterial("mooney_rivlin_2", (15e3, 28e3)),
+    "neo_hookean": WallMaterial("neo_hookean", (43e3,)),
+    "yeoh": WallMaterial("yeoh", (43e3, 200e3, 100e3)),
+}
+PATCH = (0.04, 0.02, 5e-3)  # m: length, width and mesh size of the uniaxial patch
+
+
+def thin_wall_pressure(stretch, material: WallMaterial, radius=TUBE_RADIUS, thickness=WALL_T):
+    """Inflation pressure of a thin incompressible tube in plane strain at hoop stretch ``stretch``, Pa."""
+    l = np.asarray(stretch, dtype=float)
+    i = l**2 + 1.0 + l**-2
+    d = material.law_model(i, i, material.parameters)
+    return 2.0 * thickness / radius * (1.0 - l**-4) * (d.W1 + d.W2)
+
+
+def uniaxial_patch(material: WallMaterial, stretch) -> Comparison:
+    """A flat patch stretched by ``stretch`` between grips that hold only the axial coordinate.
+
+    The static solve finds the lateral contraction itself; the grip force over the reference
+    section W t against the law's nominal stress.
+    """
+    length, width, h = PATCH
+    nodes, tri = flat_sheet(length, width, h)
+    shell = Shell(nodes, tri, WALL_T, material)
+    grip = np.isclose(nodes[:, 0], length)
+    fixed = np.isclose(nodes[:, 0], 0.0)
+    free = np.ones(nodes.shape, dtype=bool)
+    free[grip | fixed, 0] = False
+    free[:, 2] = False  # in-plane: the hinges stay flat and carry nothing
+    free[np.argmin(nodes[:, 0] + nodes[:, 1]), 1] = False  # no rigid sliding across
+    start = shell.x0 * [stretch, 1.0, 1.0]
+    expected = float(material.uniaxial_nominal_stress(stretch))
+    x, _ = minimize_energy(start, free, shell.internal_forces, force_tol=1e-7 * expected * width * WALL_T)
+    f = np.zeros_like(x)
+    shell.internal_forces(x, f)
+    measured = -f[grip, 0].sum() / (width * WALL_T)
+    return Comparison(f"{material.law}: uniaxial nominal stress 2 (l - l^-2)(W1 + W2 / l) at l = {stretch:g}",
+                      expected, float(measured), "Pa")
+
+
+def inflated_section(material: WallMaterial, stretch, length=0.02) -> Comparison:
+    """A tube section with every axial coordinate fixed (a periodic slice of a long tube), closed
+    by flat end caps, under p(l) / cos(pi/m) (the inscribed ring's exact correction); its mean
+    hoop stretch against ``stretch``."""
+    shell, ring, cos_factor = inflation_tube(length, material)
+    last = np.flatnonzero(ring == ring.max())
+    free = np.ones(shell.x0.shape, dtype=bool)
+    free[:, 0] = False
+    pressure = float(thin_wall_pressure(stretch, material)) / cos_factor
+
+    def potential(x, f):
+        energy = shell.internal_forces(x, f)
+        shell.pressure_forces(x, pressure, f)
+        return energy - pressure * _closed_volume(shell, x, last, length)
+
+    x, _ = minimize_energy(shell.x0, free, potential, force_tol=1e-5 * pressure * TUBE_H**2)
+    r = np.hypot(x[:, 1], x[:, 2]) / TUBE_RADIUS
+    return Comparison(f"{material.law}: hoop stretch of a plane-strain section at p(l = {stretch:g})", float(stretch),
+                      float(r.mean()))
