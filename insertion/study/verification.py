@@ -42,10 +42,6 @@ class Comparison:
         """(measured - analytic) / |analytic|; NaN when the analytic value is zero."""
         return (self.measured - self.analytic) / abs(self.analytic) if self.analytic != 0.0 else math.nan
 
-    def to_dict(self) -> dict:
-        return {"quantity": self.quantity, "analytic": self.analytic, "measured": self.measured, "unit": self.unit,
-                "relative_error": self.relative_error}
-
 
 def reference_material():
     return load_material(REFERENCE_MATERIAL_PATH)
