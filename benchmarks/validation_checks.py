@@ -12,7 +12,8 @@ from matplotlib.figure import Figure
 
 from colonsim.files import save_figure
 from colonsim.insertion.study.verification import WALL_T, reference_material
-from colonsim.insertion.study.verification_rod import beam_column_tip_deflection, buckling_check, elastica_tip_deflection
+from colonsim.insertion.study.verification_rod import (beam_column_tip_deflection, buckling_check,
+                                                       elastica_tip_deflection)
 from colonsim.insertion.study.verification_rules import Run
 from colonsim.insertion.study.verification_shell import TUBE_RADIUS, thin_wall_pressure
 from colonsim.insertion.study.verification_table import BUCKLING_ROD, evaluate
@@ -65,8 +66,9 @@ def inflation_figure(verdicts, figures, out):
     ax = fig.subplots()
     line = np.linspace(1.0, 1.65, 200)
     ax.plot(line, thin_wall_pressure(line, material) / 1e3, "k-", lw=1, label="thin-wall theory (plane strain)")
-    ax.plot([c.measured for c in sections], thin_wall_pressure(np.array([c.analytic for c in sections]), material) / 1e3,
-            "o", c="tab:red", label="shell model: stretch reached at that pressure")
+    targets = np.array([c.analytic for c in sections])
+    ax.plot([c.measured for c in sections], thin_wall_pressure(targets, material) / 1e3, "o", c="tab:red",
+            label="shell model: stretch reached at that pressure")
     if clamped:
         ax.plot([c.measured for c in clamped], thin_wall_pressure(np.array([c.analytic for c in clamped])) / 1e3,
                 "s", mfc="none", c="tab:blue", label="clamped tube, middle ring")

@@ -111,7 +111,8 @@ def clamped_grips_check() -> Comparison:
 def mesh_convergence_check(fine) -> Comparison:
     """Force at 60 mm of the default mesh against the ``fine`` (n_length, n_width) one."""
     coarse, finer = mesh_convergence(fine=fine)
-    return Comparison(f"mesh convergence: force at 60 mm, default 8 x 3 P2 vs {fine[0]} x {fine[1]}", finer, coarse, "N")
+    return Comparison(f"mesh convergence: force at 60 mm, default 8 x 3 P2 vs {fine[0]} x {fine[1]}", finer, coarse,
+                      "N")
 
 
 def ground_truth(data=DATA) -> dict:

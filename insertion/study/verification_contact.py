@@ -121,7 +121,8 @@ def rod_resting_on_wall(load=1.0) -> tuple[Comparison, Comparison, Comparison]:
                        extra={"force on the rod / load": float(contact.force_on_rod[2]) / load}),
             Comparison("resting rod: max |energy balance| / work", 0.0,
                        float(np.max(np.abs(hist.total_energy_balance()))) / work,
-                       extra={"contact energy / (F pen / 2)": float(hist.contacts[0]["energy"][-1]) / (0.5 * load * expected)}))
+                       extra={"contact energy / (F pen / 2)":
+                              float(hist.contacts[0]["energy"][-1]) / (0.5 * load * expected)}))
 
 
 def tip_on_node(load=0.2) -> Comparison:

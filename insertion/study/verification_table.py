@@ -17,7 +17,8 @@ from colonsim.insertion.study.verification_contact import (damped_push_balance, 
 from colonsim.insertion.study.verification_rod import (axial_wave, buckling_check, cantilever_tip_deflection,
                                                        euler_buckling_load)
 from colonsim.insertion.study.verification_rules import SAME, Bound, Check, Equal, Relative, Run, Verdict
-from colonsim.insertion.study.verification_shell import cylinder_bending, inflate_clamped_tube, inflate_section, sphere_bending
+from colonsim.insertion.study.verification_shell import (cylinder_bending, inflate_clamped_tube, inflate_section,
+                                                         sphere_bending)
 
 # (length, segment spacing) of the dynamic buckling runs, m: full size and CI size (the discrete
 # critical load of the shorter rod is within 0.1 % of Euler's as well)
@@ -42,24 +43,27 @@ _PULLED = "the resting rod under N = 1 N, mu = 0.3, pulled along its axis for 5 
 
 CHECKS: tuple[Check, ...] = (
     # --- rod ---
-    *[Check(f"rod.cantilever_{h * 1e3:g}mm", "rod", f"cantilever tip deflection P L^3 / (3 EI), 30 cm, {h * 1e3:g} mm segments",
+    *[Check(f"rod.cantilever_{h * 1e3:g}mm", "rod",
+            f"cantilever tip deflection P L^3 / (3 EI), 30 cm, {h * 1e3:g} mm segments",
             Run(cantilever_tip_deflection, (0.3, h)), (Relative(0.01),),
             "static deflection at delta / L = 0.5 % by dynamic relaxation (first mode critically damped, 16 time "
             "constants): the discrete moment-area sum is a midpoint rule, error ~(h/L)^2 / 4 = 3e-4 at 1 cm; the "
             "relaxation residual is below 1e-4; the geometric nonlinearity ~1e-5",
             reduced=SAME if h == 0.01 else None) for h in (0.01, 0.005)],
-    *[Check(f"rod.euler_load_{h * 1e3:g}mm", "rod", f"Euler load pi^2 EI / (4 L^2), clamped-free, 30 cm, {h * 1e3:g} mm segments",
+    *[Check(f"rod.euler_load_{h * 1e3:g}mm", "rod",
+            f"Euler load pi^2 EI / (4 L^2), clamped-free, 30 cm, {h * 1e3:g} mm segments",
             Run(euler_buckling_load, (0.3, h)), (Relative(0.02),),
             "the load where the tangent stiffness of the straight compressed rod (dead load, from the rod's own "
             "forces by central differences) first loses positive definiteness: the discrete Euler problem converges "
             "as (h/L)^2, ~0.1 %",
             reduced=SAME if h == 0.01 else None) for h in (0.01, 0.005)],
     Check("rod.wave_speed", "rod", "axial wave speed sqrt(E / rho)", Run(axial_wave, pick=0), (Relative(0.02),), _WAVE),
-    Check("rod.impedance", "rod", "push force rho c A v0 (impedance)", Run(axial_wave, pick=1), (Relative(0.02),), _WAVE),
+    Check("rod.impedance", "rod", "push force rho c A v0 (impedance)", Run(axial_wave, pick=1), (Relative(0.02),),
+          _WAVE),
     Check("rod.buckling_below", "rod", "tip deflection / L at P = 0.95 P_E, beam-column theory",
           Run(buckling_check, (0.95, *BUCKLING_ROD["full"])), (Bound(0.0, 0.03),),
-          _BUCKLING + ": linear theory amplifies the imperfection's deflection (8e-4 L) about 1 / (1 - 0.95) = 20 times "
-          "to ~0.015 L; the straight rod must stay stable (bound 0.03)",
+          _BUCKLING + ": linear theory amplifies the imperfection's deflection (8e-4 L) about 1 / (1 - 0.95) = 20 "
+          "times to ~0.015 L; the straight rod must stay stable (bound 0.03)",
           reduced=Run(buckling_check, (0.95, *BUCKLING_ROD["reduced"]))),
     Check("rod.buckling_above", "rod", "tip deflection / L at P = 1.05 P_E, elastica",
           Run(buckling_check, (1.05, *BUCKLING_ROD["full"])), (Bound(lower=0.15),),
@@ -70,10 +74,10 @@ CHECKS: tuple[Check, ...] = (
     *[Check(f"shell.section_{s:g}", "shell", f"hoop stretch of a plane-strain tube section at p(l = {s:g})",
             Run(inflate_section, (s,)), (Relative(1e-3), Bound(upper=1e-3, of="nodal spread")),
             "static solve (membrane + hinge energy - p V) of a 2 cm periodic section of a tube (R = 18 mm, 3 mm "
-            "triangles) with every axial coordinate fixed, at the closed-form pressure with the exact inscribed-polygon "
-            "correction 1 / cos(pi/m): it must expand uniformly to l (hinges stay unbent: the polygon's dihedral angles "
-            "do not change); the remainder, 3e-5 at l = 1.05 to 3.5e-4 at 1.6, is the ring-to-ring triangles tilting "
-            "out of the hoop plane",
+            "triangles) with every axial coordinate fixed, at the closed-form pressure with the exact "
+            "inscribed-polygon correction 1 / cos(pi/m): it must expand uniformly to l (hinges stay unbent: the "
+            "polygon's dihedral angles do not change); the remainder, 3e-5 at l = 1.05 to 3.5e-4 at 1.6, is the "
+            "ring-to-ring triangles tilting out of the hoop plane",
             reduced=SAME if s in SECTION_STRETCHES_CI else None) for s in SECTION_STRETCHES],
     *[Check(f"shell.clamped_tube_{s:g}", "shell",
             f"middle-ring hoop stretch of a clamped tube, L = {CLAMPED_TUBE[1]:g} R, p(l = {s:g})",
@@ -143,17 +147,21 @@ CHECKS: tuple[Check, ...] = (
     # --- specimen (calibration) ---
     Check("specimen.membrane_uniaxial", "specimen",
           "membrane law, F = diag(l, l^-1/2): nominal stress at the worst of l = 1.05..1.6",
-          Run(membrane_uniaxial_check), (Relative(1e-12), Bound(upper=1e-9, of="lateral / axial stress", inclusive=True)),
+          Run(membrane_uniaxial_check),
+          (Relative(1e-12), Bound(upper=1e-9, of="lateral / axial stress", inclusive=True)),
           "the same closed form evaluated through the plane-stress membrane with free lateral contraction: round-off "
           "only, and no lateral stress"),
-    Check("specimen.sliding_grips", "specimen", "sliding grips: force at the worst of 3..60 mm vs homogeneous uniaxial tension",
+    Check("specimen.sliding_grips", "specimen",
+          "sliding grips: force at the worst of 3..60 mm vs homogeneous uniaxial tension",
           Run(sliding_grips_check), (Relative(5e-3),),
           "without the clamp the strip is homogeneous and constant F is in the P2 space: exact on any mesh up to the "
           "Newton tolerance, so 0.5 % at the worst point is a loose bound"),
-    Check("specimen.clamped_grips", "specimen", "clamped grips: force excess over the closed form, largest over 3..60 mm",
+    Check("specimen.clamped_grips", "specimen",
+          "clamped grips: force excess over the closed form, largest over 3..60 mm",
           Run(clamped_grips_check), (Bound(upper=0.05), Bound(lower=0.01, of="smallest excess")),
           "the clamp holds the strip's ends from contracting, which stiffens this strip by 2-3 % (docs/model.md)"),
-    Check("specimen.mesh_convergence", "specimen", "mesh convergence: force at 60 mm, default 8 x 3 P2 vs 32 x 12 (CI: 24 x 9)",
+    Check("specimen.mesh_convergence", "specimen",
+          "mesh convergence: force at 60 mm, default 8 x 3 P2 vs 32 x 12 (CI: 24 x 9)",
           Run(mesh_convergence_check, ((32, 12),)), (Relative(5e-3),),
           "the calibration default must be converged well below the 0.05 N load-cell noise (~0.3 %)",
           reduced=Run(mesh_convergence_check, ((24, 9),))),
