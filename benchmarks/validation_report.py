@@ -168,8 +168,7 @@ def main(argv=None):
 
     print("verification ...", flush=True)
     t = time.perf_counter()
-    verification = (checks.verify_rod(full, figs, out) + checks.verify_shell(full, figs, out)
-                    + checks.verify_energy_contact() + checks.verify_specimen(full))
+    verification = checks.verify(full, figs, out)
     t_verification = time.perf_counter() - t
     print(f"  {sum(r['passed'] for r in verification)}/{len(verification)} pass, {t_verification:.0f} s", flush=True)
     print("calibration recovery ...", flush=True)

@@ -2,14 +2,16 @@
 homogeneous uniaxial tension, its mesh convergence, and recovery of the known parameters of the
 bundled synthetic specimens (``data/tensile/ground_truth.json``).
 
-The test-suite (``tests/test_specimen.py``, ``tests/test_calibration.py``) asserts on these
-numbers and ``benchmarks/validation_report.py`` tabulates them. Forces in N, lengths in m,
-parameters in Pa.
+The ``*_check`` functions return the comparisons that the verification table
+(:mod:`colonsim.insertion.study.verification_table`) judges; the recovery is asserted by
+``tests/test_calibration.py`` and reported by ``benchmarks/validation_report.py``. Forces in N,
+lengths in m, parameters in Pa.
 """
 
 from __future__ import annotations
 
 import json
+import math
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -23,6 +25,7 @@ from colonsim.identification.population import calibrate_curve
 from colonsim.identification.specimen import ClampedStripModel
 from colonsim.identification.testdata import TensileCurve, read_manifest
 from colonsim.identification.uniaxial import homogeneous_force
+from colonsim.insertion.study.verification import Comparison
 
 # docs/model.md: the source's identified parameters (C10, C01, C11), Pa.
 REFERENCE = np.array([652.01, 42835.25, 219120.3])
@@ -75,6 +78,41 @@ def mesh_convergence(displacement=DISPLACEMENTS[-1], params=REFERENCE, strip=STR
     coarse = ClampedStripModel(length, width, thickness).solve(params, [displacement])[0]
     finer = ClampedStripModel(length, width, thickness, n_length=fine[0], n_width=fine[1]).solve(params, [displacement])[0]
     return float(coarse), float(finer)
+
+
+def membrane_uniaxial_check(stretches=tuple(np.linspace(1.05, 1.6, 8))) -> Comparison:
+    """The membrane's nominal stress at the worst of ``stretches`` against the closed form, with
+    the largest |lateral stress| over the largest axial stress as "lateral / axial stress"."""
+    axial, closed, lateral = membrane_uniaxial_stress(stretches)
+    k = int(np.argmax(np.abs(axial / closed - 1.0)))
+    return Comparison("membrane law, F = diag(l, l^-1/2): nominal stress at the worst of l = 1.05..1.6",
+                      float(closed[k]), float(axial[k]), "Pa",
+                      extra={"lateral / axial stress": float(np.abs(lateral).max() / axial.max())})
+
+
+def sliding_grips_check() -> Comparison:
+    """Sliding grips: the FE force at the worst displacement against homogeneous tension, with
+    that displacement (mm)."""
+    c = specimen_against_closed_form("sliding")
+    k = int(np.argmax(np.abs(c.relative_difference)))
+    return Comparison("sliding grips: force at the worst of 3..60 mm vs homogeneous uniaxial tension",
+                      float(c.closed_form[k]), float(c.model[k]), "N",
+                      extra={"worst displacement, mm": float(c.displacement[k] * 1e3)})
+
+
+def clamped_grips_check() -> Comparison:
+    """Clamped grips: the largest force excess over the closed form (no analytic value: NaN), with
+    the smallest as "smallest excess"."""
+    excess = specimen_against_closed_form("clamped").relative_difference
+    return Comparison("clamped grips: force excess over the closed form, largest over 3..60 mm", math.nan,
+                      float(excess.max()), extra={"smallest excess": float(excess.min())})
+
+
+def mesh_convergence_check(fine) -> Comparison:
+    """Force at 60 mm of the default mesh against the ``fine`` (n_length, n_width) one."""
+    coarse, finer = mesh_convergence(fine=fine)
+    return Comparison(f"mesh convergence: force at 60 mm, default 8 x 3 P2 vs {fine[0]} x {fine[1]}", finer, coarse,
+                      "N")
 
 
 def ground_truth(data=DATA) -> dict:

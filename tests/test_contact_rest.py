@@ -1,4 +1,6 @@
-"""Rod resting on a wall: penetration F / k, energy balance, broad phase against all pairs."""
+"""Contact search: the broad phase against all pairs, threaded against serial narrow phase. The
+penetrations F / k of a resting rod and of the tip, with their force and energy balances, are rows
+of the verification table (tests/test_verification_table.py)."""
 
 import numpy as np
 import pytest
@@ -8,25 +10,10 @@ from colonsim.insertion.engine.material import REFERENCE_MATERIAL_PATH, load_mat
 from colonsim.insertion.engine.rod import Rod
 from colonsim.insertion.engine.sheet_mesh import straight_tube
 from colonsim.insertion.engine.shell import Shell
-from colonsim.insertion.study.verification import SCOPE_D, SCOPE_E, SCOPE_RHO, WALL_T, rod_on_sheet, rod_resting_on_wall, tip_on_node
+from colonsim.insertion.study.verification import SCOPE_D, SCOPE_E, SCOPE_RHO, WALL_T
+from colonsim.insertion.study.verification_contact import rod_on_sheet
 
 E, RHO, D, T = SCOPE_E, SCOPE_RHO, SCOPE_D, WALL_T
-
-
-def test_rod_resting_on_wall_penetrates_f_over_k():
-    # A load F spread over the rod like its weight, 11 contact springs k in parallel: at rest
-    # the mean penetration is F / (11 k) exactly (vertical force balance). Tolerance 0.5 %: the
-    # relaxation residual (contact springs critically damped, 30 time constants); measured 2e-10.
-    F = 1.0
-    r = rod_resting_on_wall(F)
-    assert r.n_active == r.n_under == 11
-    assert r.penetration.measured == pytest.approx(r.penetration.analytic, rel=0.005)
-    assert r.normal_force == pytest.approx(F, rel=0.005)
-    assert r.force_on_rod_z == pytest.approx(F, rel=0.005)
-    # energy: kinetic + strain + contact penalty + dissipated - work of the load is conserved
-    # to 2 % of the work (the contact damping power is evaluated at the half-step velocity)
-    assert r.energy_residual < 0.02 * r.work
-    assert r.contact_energy == pytest.approx(0.5 * F * r.penetration.analytic, rel=0.01)
 
 
 def test_broad_phase_finds_every_contact_of_all_pairs():
@@ -87,12 +74,3 @@ def test_threaded_narrow_phase_matches_serial():
     assert np.allclose(out[0][1], out[1][1], rtol=0, atol=1e-12)
     assert out[0][2] == pytest.approx(out[1][2], rel=1e-12)
 
-
-def test_hemispherical_tip_pressed_on_a_node_penetrates_f_over_k():
-    # A short rod standing tip-down over one wall node, guided along its axis (a sheath over
-    # its whole length) and pushed with F: only the node under the tip touches (its neighbours,
-    # 5 mm aside, are 1.5 mm clear of the 7.4 mm sphere), so the tip sinks F / k into it.
-    # Tolerance 0.5 %: relaxation residual of the critically damped contact spring.
-    penetration, n_active = tip_on_node(0.2)
-    assert n_active == 1
-    assert penetration.measured == pytest.approx(penetration.analytic, rel=0.005)

@@ -1,28 +1,11 @@
-"""Dynamic Euler buckling: a clamped-free rod under a dead axial load just below and just above
-pi^2 EI / (4 L^2) (the load-deflection counterpart of the tangent-stiffness test)."""
+"""The closed forms of dynamic Euler buckling (a clamped-free rod under a dead axial load just
+below and just above pi^2 EI / (4 L^2)); the dynamic runs are rows of the verification table."""
 
 import math
-import os
 
 import pytest
 
-from colonsim.insertion.study.verification import beam_column_tip_deflection, buckling_tip_deflection, elastica_tip_deflection
-
-FULL = os.environ.get("COLONSIM_FULL") == "1"
-
-
-@pytest.mark.slow
-def test_buckles_within_five_percent_of_euler_load():
-    # 5 % below the Euler load the straight rod is stable: the imperfection's linear tip
-    # deflection (1e-3 pi^2/12 L = 8e-4 L) is amplified about 1 / (1 - 0.95) = 20 times, to
-    # ~0.02 L (bound 0.03 L). 5 % above, it buckles: the elastica at P / P_cr = 1.05 has a tip
-    # rotation of ~0.6 rad and a lateral tip deflection of ~0.35 L (bound 0.15 L). Reduced size:
-    # 15 cm rod with 20 segments (the discrete critical load is within 0.1 % of Euler's).
-    length, spacing = (0.3, 0.01) if FULL else (0.15, 0.0075)
-    below = buckling_tip_deflection(0.95, length, spacing)
-    above = buckling_tip_deflection(1.05, length, spacing)
-    assert 0.0 < below < 0.03
-    assert above > 0.15
+from colonsim.insertion.study.verification_rod import beam_column_tip_deflection, elastica_tip_deflection
 
 
 def test_closed_forms_of_the_buckling_figure():

@@ -1,31 +1,15 @@
-"""Inflation of a thin incompressible Mooney-Rivlin tube against thin-wall theory.
+"""Inflation of a thin incompressible Mooney-Rivlin tube: the pressure load and the closed form.
 
-Closed form (axial stretch held at 1, i.e. ends fixed axially: plane strain along the tube).
-A tube of mid-surface radius R and wall thickness t inflates to radius r = l R. The principal
-stretches are l (hoop), 1 (axial) and 1/l (thickness), so I1 = I2 = I = l^2 + 1 + l^-2 and
-W(l) = (C10 + C01)(I - 3) + C11 (I - 3)^2. Per unit length the strain energy is 2 pi R t W(l) and
-the enclosed volume pi R^2 l^2; equilibrium p dV = dE gives
-
-    p(l) = t W'(l) / (l R) = (2 t / R) (1 - l^-4) [C10 + C01 + 2 C11 (l^2 + l^-2 - 2)],
-
-the same as Laplace's law p r = sigma_theta t / l with the plane-stress Cauchy hoop stress
-sigma_theta = l W'(l).
-
-Discrete correction (exact, not fitted): the mesh's rings are m-gons inscribed in the circle. Under
-uniform inflation each triangle's hoop stretch is exactly l, but the reference area is the
-polygon's (perimeter 2 m R sin(pi/m)) and so is the volume ((m/2) r^2 sin(2 pi/m) per length), so
-the discrete relation is p(l) / cos(pi / m) (+0.34 % for m = 38).
+The thin-wall closed form p(l) and the inscribed-polygon correction are derived in
+:mod:`colonsim.insertion.study.verification_shell`; the inflated sections and the clamped tube
+against it are rows of the verification table (tests/test_verification_table.py).
 """
-
-import os
 
 import numpy as np
 import pytest
 
-from colonsim.insertion.study.verification import (TUBE_RADIUS, WALL_T, inflate_clamped_tube, inflate_section, inflation_tube,
-                                    reference_material, thin_wall_pressure)
-
-FULL = os.environ.get("COLONSIM_FULL") == "1"
+from colonsim.insertion.study.verification import WALL_T, reference_material
+from colonsim.insertion.study.verification_shell import TUBE_RADIUS, inflation_tube, thin_wall_pressure
 
 
 def test_pressure_load_is_volume_gradient(serial_kernels):
@@ -46,34 +30,6 @@ def test_pressure_load_is_volume_gradient(serial_kernels):
             xm[i, k] -= h
             grad = (shell.enclosed_volume(xp) - shell.enclosed_volume(xm)) / (2.0 * h)
             assert grad == pytest.approx(f[i, k], abs=1e-6 * np.max(np.abs(f)))
-
-
-@pytest.mark.parametrize("stretch", [1.05, 1.2, 1.4, 1.6])
-def test_plane_strain_section_follows_thin_wall_theory(stretch, serial_kernels):
-    """A tube section with every node's axial coordinate fixed (axial stretch 1, ends free to
-    expand: a periodic slice of an infinitely long tube) under p(l) / cos(pi/m).
-
-    Static solve of the membrane + hinge energy minus p V. The section must expand uniformly to
-    l within 1e-3 (measured: 3e-5 at l = 1.05 up to 3.5e-4 at l = 1.6, the remainder from the
-    ring-to-ring triangles tilting slightly out of the hoop plane; hinges stay unbent under
-    uniform inflation because the dihedral angles of the inscribed polygon do not change).
-    """
-    stretch_check, spread = inflate_section(stretch)
-    assert stretch_check.measured == pytest.approx(stretch, rel=1e-3)
-    assert spread < 1e-3
-
-
-@pytest.mark.slow
-def test_tube_with_fixed_ends_follows_thin_wall_theory_in_the_middle():
-    """A tube with both end rings clamped and every axial coordinate fixed; away from the ends
-    the wall must reach the plane-strain thin-wall stretch. The clamped rings hold the wall back
-    over a boundary layer a few radii long, so the middle ring is checked: reduced size L = 6 R at
-    l = 1.2, full size L = 10 R at l = 1.1, 1.2, 1.3, both to 1e-3 on the stretch (measured
-    5e-5 reduced, at most 1e-4 full).
-    """
-    checks = inflate_clamped_tube((1.1, 1.2, 1.3) if FULL else (1.2,), 10.0 if FULL else 6.0)
-    for c in checks:
-        assert c.measured == pytest.approx(c.analytic, rel=1e-3)
 
 
 def test_thin_wall_pressure_is_laplace_law():

@@ -1,4 +1,6 @@
-"""The scikit-fem specimen model (docs/model.md): tangent, grips, mesh convergence."""
+"""The scikit-fem specimen model (docs/model.md): tangents, load stepping, bad input. The uniaxial
+closed form, the grips and the mesh convergence are rows of the verification table
+(tests/test_verification_table.py)."""
 
 import numpy as np
 import pytest
@@ -7,8 +9,7 @@ from colonsim.errors import ColonsimError
 from colonsim.laws import get_law
 from colonsim.identification.membrane import membrane_stress
 from colonsim.identification.specimen import ClampedStripModel, FEConvergenceError
-from colonsim.identification.verification import (DISPLACEMENTS, REFERENCE, STRIP, membrane_uniaxial_stress, mesh_convergence,
-                                         specimen_against_closed_form)
+from colonsim.identification.verification import DISPLACEMENTS, REFERENCE, STRIP
 
 L, W, T = STRIP
 D = DISPLACEMENTS  # up to 60 % strain, the end of the test
@@ -26,31 +27,6 @@ def test_membrane_tangent_matches_finite_differences(law, params):
         numeric = (membrane_stress(F + e, get_law(law), params, False) - membrane_stress(F - e, get_law(law), params, False)) / (2 * h)
         # central differences: error O(h^2 |P'''|) ~ 1e-10 relative; 1e-6 leaves room for round-off
         np.testing.assert_allclose(A[:, :, k], numeric, rtol=1e-6, atol=1e-6 * np.abs(A).max())
-
-
-def test_membrane_uniaxial_state_matches_closed_form():
-    axial, closed_form, lateral = membrane_uniaxial_stress(np.linspace(1.05, 1.6, 8))  # free lateral contraction
-    np.testing.assert_allclose(axial, closed_form, rtol=1e-12)
-    np.testing.assert_allclose(lateral, 0.0, atol=1e-9 * axial.max())  # no lateral stress
-
-
-def test_sliding_grips_equal_the_closed_form():
-    """Without the clamp the strip is homogeneous: any mesh reproduces the closed form exactly
-    (constant F is in the P2 space), so the 0.5 % of the issue is a loose bound."""
-    c = specimen_against_closed_form("sliding")
-    np.testing.assert_allclose(c.model, c.closed_form, rtol=5e-3)
-
-
-def test_clamped_grips_are_stiffer_by_a_few_percent():
-    """docs/model.md: the clamp blocks lateral contraction near the grips, 2-3 % for this geometry."""
-    excess = specimen_against_closed_form("clamped").relative_difference
-    assert np.all(excess > 0.01) and np.all(excess < 0.05), excess
-
-
-def test_default_mesh_is_converged_to_half_a_percent():
-    """8 x 3 P2 (the calibration default) against a 4x finer mesh at the most strained point."""
-    coarse, fine = mesh_convergence(D[-1], fine=(24, 9))
-    assert coarse == pytest.approx(fine, rel=5e-3)
 
 
 def test_force_at_each_displacement_independent_of_sampling():

@@ -5,7 +5,8 @@ so each is checked on the two homogeneous states whose answers follow from the l
 (docs/model.md): a flat patch in uniaxial tension against the law's nominal stress
 P = 2 (l - l^-2) (W1 + W2 / l), and a plane-strain tube section inflated by the thin-wall pressure
 p(l) = (2 t / R) (1 - l^-4) (W1 + W2) at I1 = I2 = l^2 + 1 + l^-2 (derivation in
-tests/test_shell_inflation.py). The tolerances and their reasons are in tests/test_wall_laws.py.
+:mod:`colonsim.insertion.study.verification_shell`). The rows, tolerances and reasons are in
+:mod:`colonsim.insertion.study.verification_table` (group ``law``).
 """
 
 from __future__ import annotations
@@ -16,8 +17,8 @@ from colonsim.insertion.engine.material import WallMaterial
 from colonsim.insertion.engine.sheet_mesh import flat_sheet
 from colonsim.insertion.engine.shell import Shell
 from colonsim.insertion.engine.statics import minimize_energy
-from colonsim.insertion.study.verification import (TUBE_H, TUBE_RADIUS, WALL_T, Comparison, _closed_volume,
-                                                   inflation_tube)
+from colonsim.insertion.study.verification import WALL_T, Comparison
+from colonsim.insertion.study.verification_shell import TUBE_RADIUS, solve_section
 
 # One material per law, all near the reference wall's small-strain shear modulus (87 kPa), with
 # the stiffening terms large enough to double the stress of the linear part at the checked stretches.
@@ -38,12 +39,14 @@ def thin_wall_pressure(stretch, material: WallMaterial, radius=TUBE_RADIUS, thic
     return 2.0 * thickness / radius * (1.0 - l**-4) * (d.W1 + d.W2)
 
 
-def uniaxial_patch(material: WallMaterial, stretch) -> Comparison:
-    """A flat patch stretched by ``stretch`` between grips that hold only the axial coordinate.
+def uniaxial_patch(law: str, stretch) -> Comparison:
+    """A flat patch of ``law``'s check material stretched by ``stretch`` between grips that hold
+    only the axial coordinate.
 
     The static solve finds the lateral contraction itself; the grip force over the reference
     section W t against the law's nominal stress.
     """
+    material = CHECK_MATERIALS[law]
     length, width, h = PATCH
     nodes, tri = flat_sheet(length, width, h)
     shell = Shell(nodes, tri, WALL_T, material)
@@ -63,22 +66,11 @@ def uniaxial_patch(material: WallMaterial, stretch) -> Comparison:
                       expected, float(measured), "Pa")
 
 
-def inflated_section(material: WallMaterial, stretch, length=0.02) -> Comparison:
-    """A tube section with every axial coordinate fixed (a periodic slice of a long tube), closed
-    by flat end caps, under p(l) / cos(pi/m) (the inscribed ring's exact correction); its mean
-    hoop stretch against ``stretch``."""
-    shell, ring, cos_factor = inflation_tube(length, material)
-    last = np.flatnonzero(ring == ring.max())
-    free = np.ones(shell.x0.shape, dtype=bool)
-    free[:, 0] = False
-    pressure = float(thin_wall_pressure(stretch, material)) / cos_factor
-
-    def potential(x, f):
-        energy = shell.internal_forces(x, f)
-        shell.pressure_forces(x, pressure, f)
-        return energy - pressure * _closed_volume(shell, x, last, length)
-
-    x, _ = minimize_energy(shell.x0, free, potential, force_tol=1e-5 * pressure * TUBE_H**2)
-    r = np.hypot(x[:, 1], x[:, 2]) / TUBE_RADIUS
-    return Comparison(f"{material.law}: hoop stretch of a plane-strain section at p(l = {stretch:g})", float(stretch),
+def inflated_section(law: str, stretch, length=0.02) -> Comparison:
+    """The periodic tube section of :func:`colonsim.insertion.study.verification_shell.solve_section`
+    made of ``law``'s check material under its thin-wall pressure p(l): its mean hoop stretch
+    against ``stretch``."""
+    material = CHECK_MATERIALS[law]
+    r = solve_section(lambda m: thin_wall_pressure(stretch, m), length, material)
+    return Comparison(f"{law}: hoop stretch of a plane-strain section at p(l = {stretch:g})", float(stretch),
                       float(r.mean()))
