@@ -48,7 +48,7 @@ def header(doc):
         f"calibration {doc['timings']['calibration_s']:.0f} s), one Numba thread", "",
         "The model and its assumptions: `docs/model.md`. Every number of this project below is computed by this "
         "script or read from the sweeps' tables and run folders; the source's numbers are constants of "
-        "`insertion/reference.py` (LS-DYNA results of the source's Chapter V). Scopes are named by the diameters of "
+        "`insertion/study/reference.py` (LS-DYNA results of the source's Chapter V). Scopes are named by the diameters of "
         "the source's scope meshes (UTC 9.2, PDC 11.1, SDC 13.3 mm; the catalogue's PDC and SDC are 11.3 and "
         "12.8 mm, docs/model.md, \"Colonoscope\").", ""]
 
@@ -150,7 +150,7 @@ def claims(claim_list):
         return f"{sum(e['holds'] is True for e in rows)} of {len(rows)}" if rows else "-"
 
     lines = ["## 4. The source's claims", "",
-             "Each claim is evaluated on the main sweep's table by a function of `insertion/claims.py` (unit-tested "
+             "Each claim is evaluated on the main sweep's table by a function of `insertion/study/claims.py` (unit-tested "
              "in `tests/test_claims.py`). REPRODUCED: every comparison of the criterion holds. NOT REPRODUCED: all "
              "runs present and at least one comparison fails. NOT EVALUATED: a run the criterion needs is missing "
              "or failed; nothing is inferred from the runs present. Deformations in cm; reductions and advantages "
@@ -229,7 +229,7 @@ def mesh_pair(section):
                          "main sweep (3 mm triangles, the source's size) run again on 2 mm triangles by the validation "
                          "sweep. Each cell: 3 mm / 2 mm value in cm; change = (2 mm - 3 mm) / 3 mm. A and C are the "
                          "RSJ's points. A change is not judged where both values are below 0.1 cm "
-                         "(`insertion/claims.py`, NO_DEFORMATION_CM: nothing measurable). Pass: every judged change "
+                         "(`insertion/study/claims.py`, NO_DEFORMATION_CM: nothing measurable). Pass: every judged change "
                          "under 5 %.", section)
 
 
