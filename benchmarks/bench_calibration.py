@@ -24,7 +24,6 @@ from colonsim.identification.pipeline import Budget, calibrate
 from colonsim.identification.specimen import ClampedStripModel
 from colonsim.identification.testdata import mean_curve, read_manifest
 
-DATA = TENSILE_DIR
 REFERENCE = np.array([652.01, 42835.25, 219120.3])
 MESHES = [(4, 1), (6, 2), (8, 3), (12, 4), (16, 6), (24, 8), (32, 12), (48, 16)]
 
@@ -84,7 +83,7 @@ def main():
     parser.add_argument("--skip-pipeline", action="store_true")
     args = parser.parse_args()
 
-    curve = mean_curve(read_manifest(DATA / "manifest.csv"))
+    curve = mean_curve(read_manifest(TENSILE_DIR / "manifest.csv"))
     points = np.linspace(curve.max_displacement / 20, curve.max_displacement, 20)
     print(f"specimen: {curve.length * 1e3:.0f} x {curve.width * 1e3:.0f} x {curve.thickness * 1e3:.3f} mm, "
           f"reference parameters, 20 displacement points up to {points[-1] * 1e3:.2f} mm")

@@ -18,6 +18,7 @@ os.environ.setdefault("NUMBA_NUM_THREADS", "1")  # this process only waits and w
 
 from colonsim.insertion.study.sweep import run_sweep  # noqa: E402
 from colonsim.insertion.study.sweep_spec import PRESETS, load_sweep  # noqa: E402
+from colonsim.workflows import available_cores  # noqa: E402
 
 
 def spread(cases, n):
@@ -31,7 +32,7 @@ def spread(cases, n):
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--preset", default="thesis", choices=sorted(PRESETS))
-    parser.add_argument("--workers", type=int, default=len(os.sched_getaffinity(0)))
+    parser.add_argument("--workers", type=int, default=available_cores())
     parser.add_argument("--limit", type=int, default=None, help="run only N cases spread over the preset")
     parser.add_argument("--out", type=Path, default=None, help="sweep folder (default: a temporary folder)")
     args = parser.parse_args(argv)
@@ -41,7 +42,7 @@ def main(argv=None):
     with tempfile.TemporaryDirectory(prefix="bench_sweep_") as tmp:
         out = args.out or Path(tmp)
         print(f"preset {args.preset}: {len(cases)} of {len(spec.cases)} runs, {args.workers} worker process(es), "
-              f"{len(os.sched_getaffinity(0))} cores, load average {os.getloadavg()[0]:.1f} at start", flush=True)
+              f"{available_cores()} cores, load average {os.getloadavg()[0]:.1f} at start", flush=True)
         t0 = time.perf_counter()
         report = run_sweep(cases, out, workers=args.workers, spec=spec)
         wall = time.perf_counter() - t0

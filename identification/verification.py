@@ -32,7 +32,6 @@ REFERENCE = np.array([652.01, 42835.25, 219120.3])
 # docs/model.md: free length and width of the source's strips, m; thickness 2 mm (an assumption).
 STRIP = (0.1, 0.025, 0.002)
 DISPLACEMENTS = np.linspace(3e-3, 60e-3, 6)  # up to 60 % strain, the end of the test
-DATA = TENSILE_DIR
 NAMES = ("C10", "C01", "C11")
 
 
@@ -115,7 +114,7 @@ def mesh_convergence_check(fine) -> Comparison:
                       "N")
 
 
-def ground_truth(data=DATA) -> dict:
+def ground_truth(data=TENSILE_DIR) -> dict:
     return json.loads((Path(data) / "ground_truth.json").read_text())
 
 
@@ -154,7 +153,7 @@ class SpecimenRecovery:
         return rows
 
 
-def specimen_recovery(specimen="specimen_01", budget: Budget | None = None, seed=1, data=DATA) -> SpecimenRecovery:
+def specimen_recovery(specimen="specimen_01", budget: Budget | None = None, seed=1, data=TENSILE_DIR) -> SpecimenRecovery:
     """Calibrate the bundled ``specimen`` with the FE pipeline (docs/model.md) at ``budget``."""
     truth_doc = ground_truth(data)
     curves = {c.name: c for c in read_manifest(Path(data) / "manifest.csv")}

@@ -15,14 +15,14 @@ import numpy as np
 import pandas as pd
 import pytest
 
+from colonsim.data import TENSILE_DIR
 from colonsim.cli import main
 from colonsim.insertion.engine.material import REFERENCE_MATERIAL_PATH
 from colonsim.insertion.study.sweep import SweepStore
 from colonsim.insertion.study.sweep_spec import parse_sweep
 from colonsim.surrogate.synthetic import synthetic_sweep
 
-DATA = Path(__file__).resolve().parents[1] / "data" / "tensile"
-CURVE = str(DATA / "specimen_01.csv")
+CURVE = str(TENSILE_DIR / "specimen_01.csv")
 GEOMETRY = ["--length", "100", "--width", "25", "--thickness", "2"]
 SWEEP_A = '[sweep]\nname = "a"\n[[grid]]\nsegment = "straight"\nscope = ["utc", "sdc"]\n'
 UNWRITABLE = "/proc/colonsim-test/out"  # nobody, root included, creates files in /proc
@@ -122,7 +122,7 @@ CASES = [
     (["calibrate", "--curve", CURVE, "--length", "100", "--width", "25", "--out", "{ws}/good_cal"], "thickness is missing"),
     (["calibrate", "--law", "ogden", "--out", "{ws}/good_cal"], "unknown hyperelastic law 'ogden'"),
     (["calibrate", "--points", "2", "--out", "{ws}/good_cal"], "--points 2 is too few"),
-    (["calibrate", "--curve", CURVE, "--manifest", str(DATA / "manifest.csv"), "--out", "{ws}/good_cal"], "not both"),
+    (["calibrate", "--curve", CURVE, "--manifest", str(TENSILE_DIR / "manifest.csv"), "--out", "{ws}/good_cal"], "not both"),
     # insert
     (["insert", "--segment", "rsx", "--out", "{ws}/good_insert"], "unknown colon segment 'rsx'"),
     (["insert", "--scope", "huge", "--out", "{ws}/good_insert"], "unknown scope 'huge'"),

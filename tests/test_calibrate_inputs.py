@@ -6,10 +6,11 @@ from pathlib import Path
 
 import pytest
 
+from colonsim.data import TENSILE_DIR
 from colonsim.cli import main
 
 ROOT = Path(__file__).resolve().parents[1]
-SPECIMEN = ROOT / "data" / "tensile" / "specimen_01.csv"
+SPECIMEN = TENSILE_DIR / "specimen_01.csv"
 EXPORT = ROOT / "tests" / "data" / "exports" / "instron_preamble.csv"
 GEOMETRY = ["--length", "100", "--width", "25", "--thickness", "1.8"]
 QUICK = ["--analytic", "--quick", "--no-progress"]

@@ -1,11 +1,11 @@
 """The identification pipeline (docs/model.md): recovery, reproducibility, records, result files."""
 
 import json
-from pathlib import Path
 
 import numpy as np
 import pytest
 
+from colonsim.data import TENSILE_DIR
 from colonsim.laws import get_law
 from colonsim.identification.objective import CurveObjective, make_model
 from colonsim.identification.pipeline import Budget, calibrate
@@ -15,8 +15,7 @@ from colonsim.identification.uniaxial import homogeneous_force
 from colonsim.identification.verification import specimen_recovery
 from colonsim.insertion.engine.material import load_material
 
-DATA = Path(__file__).resolve().parents[1] / "data" / "tensile"
-TRUTH = json.loads((DATA / "ground_truth.json").read_text())
+TRUTH = json.loads((TENSILE_DIR / "ground_truth.json").read_text())
 NAMES = ("C10", "C01", "C11")
 ANALYTIC = Budget(designs=40, cma_popsize=10, cma_max_evaluations=200, nm_max_evaluations=400)  # ms per evaluation
 

@@ -3,14 +3,13 @@
 import json
 import subprocess
 import sys
-from pathlib import Path
 
 import pytest
 
+from colonsim.data import TENSILE_DIR
 from colonsim.cli import main
 
-DATA = Path(__file__).resolve().parents[1] / "data" / "tensile"
-SPECIMEN = ["--curve", str(DATA / "specimen_01.csv"), "--length", "100", "--width", "25", "--thickness", "1.7786"]
+SPECIMEN = ["--curve", str(TENSILE_DIR / "specimen_01.csv"), "--length", "100", "--width", "25", "--thickness", "1.7786"]
 
 
 def test_calibrate_one_curve_analytic(tmp_path, capsys):
@@ -27,7 +26,7 @@ def test_calibrate_one_curve_analytic(tmp_path, capsys):
 def test_calibrate_per_specimen_population(tmp_path):
     manifest = tmp_path / "manifest.csv"
     manifest.write_text("specimen,file,length_mm,width_mm,thickness_mm\n"
-                        f"a,{DATA / 'specimen_01.csv'},100,25,1.7786\nb,{DATA / 'specimen_02.csv'},100,25,1.9365\n")
+                        f"a,{TENSILE_DIR / 'specimen_01.csv'},100,25,1.7786\nb,{TENSILE_DIR / 'specimen_02.csv'},100,25,1.9365\n")
     out = tmp_path / "pop"
     assert main(["calibrate", "--manifest", str(manifest), "--per-specimen", "--analytic", "--quick",
                  "--workers", "2", "--no-progress", "--out", str(out)]) == 0
@@ -39,10 +38,10 @@ def test_calibrate_per_specimen_population(tmp_path):
 
 @pytest.mark.parametrize("args,message", [
     (["--curve", "missing.csv", "--length", "100", "--width", "25", "--thickness", "2"], "not found"),
-    (["--curve", str(DATA / "specimen_01.csv"), "--length", "100", "--width", "25"], "thickness is missing"),
-    (["--curve", str(DATA / "specimen_01.csv"), "--length", "100", "--width", "25", "--thickness", "-1"],
+    (["--curve", str(TENSILE_DIR / "specimen_01.csv"), "--length", "100", "--width", "25"], "thickness is missing"),
+    (["--curve", str(TENSILE_DIR / "specimen_01.csv"), "--length", "100", "--width", "25", "--thickness", "-1"],
      "thickness must be a positive number"),
-    (["--manifest", str(DATA / "manifest.csv"), "--thickness", "2"], "go with --curve"),
+    (["--manifest", str(TENSILE_DIR / "manifest.csv"), "--thickness", "2"], "go with --curve"),
     (["--law", "ogden"], "unknown hyperelastic law"),
 ])
 def test_bad_input_is_one_line_and_exit_2(args, message, capsys, tmp_path):

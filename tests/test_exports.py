@@ -7,6 +7,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from colonsim.data import TENSILE_DIR
 from colonsim.cli import main
 from colonsim.errors import ColonsimError
 from colonsim.identification.testdata import CurveWarning, TensileCurve, read_curve, read_manifest
@@ -20,7 +21,7 @@ FROM_FILE = dict(length=0.1, width=0.025, thickness=0.00178)
 @pytest.fixture(scope="module")
 def reference():
     """Every export in the corpus holds bundled specimen_01, every 10th sample (mm, N)."""
-    c = read_curve(ROOT / "data" / "tensile" / "specimen_01.csv", **GEOM)
+    c = read_curve(TENSILE_DIR / "specimen_01.csv", **GEOM)
     return c.displacement[::10], c.force[::10]
 
 
