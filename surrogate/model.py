@@ -267,6 +267,9 @@ class SweepSurrogate:
                              f"scatter sd {gp.noise_std:.2g}  length scales ({scales})")
             for target, why in self.skipped_[seg].items():
                 lines.append(f"  {target:<22} no model: {why}")
+        if getattr(self, "tissue_", None) is not None and any(tissue_inputs(d) for d in self.domains_.values()):
+            lines.append(f"tissue: predictions without wall_mu0_kPa / wall_C11_kPa average over "
+                         f"{self.tissue_.description}")
         lines.extend(f"note: {n}" for n in self.notes_)
         if self.domains_:
             first = next(iter(self.cv_.values()), {})
