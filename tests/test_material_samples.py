@@ -183,3 +183,18 @@ def test_tissue_columns_are_the_laws_small_strain_modulus():
     cols = tissue_columns("mooney_rivlin_3", rows)
     assert np.allclose(cols[WALL_MU0], [6.0, 18.0]) and np.allclose(cols[WALL_C11], [3.0, 6.0])
     assert np.allclose(tissue_columns("neo_hookean", [[5_000.0]])[WALL_MU0], 10.0)
+
+
+def test_the_material_sections_of_the_documentation_parse(tmp_path):
+    """docs/sweeps.md's [material] snippets, added to a grid, with the calibration files they name."""
+    import re
+    from pathlib import Path
+
+    text = (Path(__file__).resolve().parents[1] / "docs" / "sweeps.md").read_text()
+    snippets = re.findall(r"```\n(\[material\].*?)```", text, flags=re.S)
+    (tmp_path / "calibration").mkdir()
+    material_file(tmp_path / "calibration")
+    population_file(tmp_path / "calibration", np.array([[10_000.0 + 1e3 * i, 30_000.0, 150_000.0] for i in range(8)]))
+    grid = '[[grid]]\nsegment = "straight"\nscope = ["utc", "pdc", "sdc"]\n'
+    sizes = [len(parse_sweep(grid + snippet, base=tmp_path).cases) for snippet in snippets]
+    assert sizes == [3 * 20, 3 * 5]
