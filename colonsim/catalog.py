@@ -261,6 +261,9 @@ INPUT, SETTING, OUTPUT, PROVENANCE = "input", "setting", "output", "provenance"
 # What the surrogate makes of a column: a continuous input it models on, an output it fits by
 # default, or one it may fit when asked (``--targets``).
 SURROGATE_INPUT, DEFAULT_TARGET, TARGET = "input", "default target", "target"
+# The wall material of a run as the surrogate sees it: its small-strain shear modulus and its C11
+# (colonsim.insertion.study.material_samples fills both for every run, the default material too).
+WALL_MU0, WALL_C11 = "wall_mu0_kPa", "wall_C11_kPa"
 
 
 @dataclass(frozen=True)
@@ -312,6 +315,12 @@ COLUMNS = {c.name: c for c in (
     Column("wall_thickness_mm", _I, "mm", "colon wall thickness", SURROGATE_INPUT, "wall thickness [mm]",
            "--wall-thickness"),
     Column("material", _S, "", "material JSON (empty: the source's parameters)"),
+    Column("material_parameters", _S, "Pa", "wall parameters drawn by a [material] section, {name: Pa} as JSON, "
+                                             "replacing the material file's (empty: the file's)"),
+    Column(WALL_MU0, _I, "kPa", "small-strain shear modulus mu0 = 2 (W1 + W2) of the run's wall material",
+           SURROGATE_INPUT, "wall shear modulus mu0 [kPa]", "--wall-mu0"),
+    Column(WALL_C11, _I, "kPa", "C11 of the run's wall material (NaN for a law without a C11 term)", SURROGATE_INPUT,
+           "wall C11 [kPa]", "--wall-c11"),
     Column("element_size_mm", _S, "mm", "wall triangle size"),
     Column("scope_spacing_mm", _S, "mm", "scope node spacing"),
     Column("push_speed", _S, "m/s", "plateau push speed"),

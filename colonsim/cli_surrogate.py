@@ -17,9 +17,13 @@ from colonsim.options import finite_float, output_file
 
 # command-line option -> results-table column
 RAW_OPTIONS = {"scope_diameter": "scope_diameter_mm", "diameter": "diameter_mm", "angle": "angle_deg",
-               "friction": "friction", "wall_thickness": "wall_thickness_mm"}
+               "friction": "friction", "wall_thickness": "wall_thickness_mm", "wall_mu0": catalog.WALL_MU0,
+               "wall_c11": catalog.WALL_C11}
 VS_NAMES = {"scope": "scope_diameter_mm", "scope-diameter": "scope_diameter_mm", "diameter": "diameter_mm",
-            "angle": "angle_deg", "friction": "friction", "wall-thickness": "wall_thickness_mm"}
+            "angle": "angle_deg", "friction": "friction", "wall-thickness": "wall_thickness_mm",
+            "wall-mu0": catalog.WALL_MU0, "wall-c11": catalog.WALL_C11}
+MATERIAL_HELP = ("calibration file of the tissue distribution predictions average over: a material.json (its "
+                 "posterior) or a population.json (its specimens); default: the one the sweep sampled")
 
 
 def _cv(text):
@@ -48,6 +52,9 @@ def _patient_options(p, scope_diameter=True):
     g.add_argument("--angle", type=finite_float, help=f"degrees: {catalog.angle_help()}")
     g.add_argument("--friction", type=finite_float, help="Coulomb friction scope/wall")
     g.add_argument("--wall-thickness", type=finite_float, help="colon wall thickness, mm")
+    g.add_argument("--wall-mu0", type=finite_float, help="a known wall's small-strain shear modulus, kPa (with --wall-c11)")
+    g.add_argument("--wall-c11", type=finite_float, help="a known wall's C11, kPa (without both: averaged over the tissue)")
+    g.add_argument("--material", type=Path, help=MATERIAL_HELP)
     g.add_argument("--strict", action="store_true", help="a query outside the training domain is an error, not a warning")
 
 
@@ -67,6 +74,8 @@ def add_parsers(sub):
     fit.add_argument("--restarts", type=int, default=2, help="extra optimizer starts per GP (default 2)")
     fit.add_argument("--min-runs", type=int, default=4, help="fewest runs a model is fitted on (default 4)")
     fit.add_argument("--seed", type=int, default=0, help="seed of the restarts and folds (default 0)")
+    fit.add_argument("--material", type=Path, help=MATERIAL_HELP.replace("predictions average", "stored with the "
+                                                                          "model, that predictions average"))
     fit.add_argument("--threads", type=int, default=1,
                      help="BLAS threads (default 1; more only pays on an idle machine with thousands of runs)")
     fit.set_defaults(func=cmd_fit)
@@ -129,10 +138,11 @@ def cmd_fit(args):
 
     if args.restarts < 0 or args.min_runs < 2 or args.threads < 1:
         raise ColonsimError("--restarts must be >= 0, --min-runs >= 2 and --threads >= 1")
+    tissue = _tissue(args)
     table = read_results(args.results)
     model = SweepSurrogate(targets=tuple(args.targets or TARGETS), segments=args.segments, cv=args.cv,
                            n_restarts=args.restarts, min_runs=args.min_runs, random_state=args.seed,
-                           threads=args.threads).fit(table)
+                           threads=args.threads, tissue=tissue).fit(table)
     json_path, npz_path = save_surrogate(model, args.out, source=args.results)
     print(model.report())
     print(f"model: {json_path} + {npz_path.name}")
@@ -146,6 +156,23 @@ def cmd_info(args):
         print(model_paths(args.model)[0].read_text(encoding="utf-8"), end="")
     else:
         print(model.report())
+
+
+def _tissue(args):
+    """The tissue distribution of --material, or None."""
+    from colonsim.surrogate.tissue import TissueDistribution
+
+    return None if args.material is None else TissueDistribution.from_file(args.material)
+
+
+def _load(args):
+    """The model of ``args.model``, with the tissue distribution of --material if given."""
+    from colonsim.surrogate.store import load_surrogate
+
+    model = load_surrogate(args.model)
+    if args.material is not None:
+        model.tissue_ = _tissue(args)
+    return model
 
 
 def _raw(args):
@@ -237,25 +264,28 @@ def _format_predictions(out, targets):
         for t in targets:
             if row[t] == row[t]:
                 unit = target_unit(t)
+                split = ("" if row[t + "_std_tissue"] != row[t + "_std_tissue"] else
+                         f"  sd: tissue {row[t + '_std_tissue']:.2g}, surrogate {row[t + '_std_surrogate']:.2g}")
                 lines.append(f"  {t:<22} {row[t]:8.4g} +- {row[t + '_std']:.2g} {unit}  "
-                             f"(95 %: {row[t + '_low95']:.4g} to {row[t + '_high95']:.4g})")
-    lines.append("(+- one standard deviation of a new simulation result; the interval is mean +- 1.96 sd)")
+                             f"(95 %: {row[t + '_low95']:.4g} to {row[t + '_high95']:.4g}){split}")
+        lines.append(f"  {row['tissue_note']}")
+    lines.append("(+- one standard deviation of a new simulation result, tissue and surrogate parts added in "
+                 "variance; the interval is mean +- 1.96 sd)")
     return "\n".join(lines)
 
 
 def cmd_predict(args):
     from colonsim.files import write_csv, write_json
-    from colonsim.surrogate.store import load_surrogate
+    from colonsim.surrogate.model import SUFFIXES
 
-    model = load_surrogate(args.model)
+    model = _load(args)
     frame = _query_frame(args, model)
     targets = list(args.target or model.targets)
     unknown = sorted(set(targets) - set(model.targets))
     if unknown:
         raise ColonsimError(f"the surrogate has no target {', '.join(unknown)}; it models {', '.join(model.targets)}")
     out = model.predict_frame(frame, targets=targets, strict=args.strict)
-    out = out.drop(columns=[t for t in targets if out[t].isna().all()
-                            for t in (t, t + "_std", t + "_low95", t + "_high95")])
+    out = out.drop(columns=[t + suffix for t in targets if out[t].isna().all() for suffix in SUFFIXES])
     shown = [t for t in targets if t in out]
     if not shown:
         why = "; ".join(f"{seg} {t}: {model.skipped_.get(seg, {}).get(t, 'not fitted')}"
@@ -278,9 +308,8 @@ def cmd_recommend(args):
     from colonsim.files import write_json
     from colonsim.surrogate.patients import describe_patient
     from colonsim.surrogate.recommend import format_recommendation, recommend
-    from colonsim.surrogate.store import load_surrogate
 
-    model = load_surrogate(args.model)
+    model = _load(args)
     segment = _segment(args, model)
     query = _patient_query(model, segment, args, _presets(args))
     rec = recommend(model, segment, query, scopes=args.scope, target=args.target, reference=args.reference,
@@ -300,9 +329,8 @@ def cmd_recommend(args):
 def cmd_plot(args):
     from colonsim.files import save_figure
     from colonsim.surrogate.plot import prediction_figure
-    from colonsim.surrogate.store import load_surrogate
 
-    model = load_surrogate(args.model)
+    model = _load(args)
     segment = _segment(args, model)
     vs = VS_NAMES.get(args.vs.lower(), args.vs)
     query = _patient_query(model, segment, args, _presets(args))

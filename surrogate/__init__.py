@@ -3,13 +3,15 @@
 Data flow: results table (one row per run) -> :class:`SweepSurrogate` (one GP per segment and
 output, cross-validated at fit time) -> JSON + NPZ files (:func:`save_surrogate`,
 :func:`load_surrogate`, no pickle) -> predictions with uncertainty, patient presets and scope
-recommendations. See docs/surrogate.md.
+recommendations, with the spread split into tissue and surrogate parts when the sweep drew wall
+materials (:mod:`colonsim.surrogate.tissue`). See docs/surrogate.md.
 """
 
 from colonsim.surrogate.domain import OutOfDomainWarning, SegmentDomain
 from colonsim.surrogate.gp import GaussianProcess
 from colonsim.surrogate.model import SweepSurrogate
 from colonsim.surrogate.table import INPUTS, SEGMENTS, TARGETS, read_results
+from colonsim.surrogate.tissue import TissueDistribution
 
 __all__ = ["GaussianProcess", "INPUTS", "OutOfDomainWarning", "SEGMENTS", "SegmentDomain", "SweepSurrogate",
-           "TARGETS", "read_results"]
+           "TARGETS", "TissueDistribution", "read_results"]

@@ -17,7 +17,12 @@ from colonsim.surrogate.domain import SegmentDomain
 from colonsim.surrogate.gp import GaussianProcess
 from colonsim.surrogate.table import (INPUT_OPTIONS, INPUTS, TARGETS, check_results, numeric_column, scope_diameter_mm,
                              scope_diameters, solver_settings, split_inputs, successful_runs)
+from colonsim.surrogate.tissue import TISSUE_INPUTS, TissueDistribution, plan, split_predict, tissue_inputs
 from colonsim.surrogate.validation import Z95, cross_validate
+from colonsim.insertion.study.material_samples import MATERIAL_PARAMETERS
+
+# columns of each target in predict_frame (the 95 % interval is mean +- 1.96 total sd)
+SUFFIXES = ("", "_std", "_low95", "_high95", "_std_tissue", "_std_surrogate")
 
 
 class SweepSurrogate:
@@ -43,10 +48,13 @@ class SweepSurrogate:
         BLAS threads during the fit (default 1). The matrices are small (runs x runs): on a machine
         shared with simulations, more BLAS threads contend for the cores and made a 500-run fit
         four times slower in the benchmark. None leaves the BLAS default.
+    tissue : TissueDistribution or None
+        The wall-material distribution predictions average over (:mod:`colonsim.surrogate.tissue`);
+        default: the one the sweep sampled, read from the runs (``tissue_``).
     """
 
     def __init__(self, targets=TARGETS, inputs=INPUTS, segments=None, cv="loo", n_restarts=2, min_runs=4,
-                 random_state=0, threads=1):
+                 random_state=0, threads=1, tissue=None):
         self.targets = targets
         self.inputs = inputs
         self.segments = segments
@@ -55,6 +63,7 @@ class SweepSurrogate:
         self.min_runs = min_runs
         self.random_state = random_state
         self.threads = threads
+        self.tissue = tissue
 
     def _make_gp(self, domain):
         return lambda: GaussianProcess(input_range=(domain.low, domain.high), n_restarts=self.n_restarts,
@@ -88,11 +97,16 @@ class SweepSurrogate:
                 self.notes_.append(f"{segment}: no successful run, no model")
                 continue
             varying, fixed = split_inputs(runs, self.inputs)
+            undefined = [n for n in self.inputs if n in runs.columns and runs[n].isna().all()]
+            if undefined:
+                self.notes_.append(f"{segment}: {', '.join(undefined)} undefined (NaN) in every run, not an input")
             settings, varying_settings = solver_settings(runs)
             low = runs[varying].min().to_numpy(dtype=float) if varying else np.zeros(0)
             high = runs[varying].max().to_numpy(dtype=float) if varying else np.zeros(0)
             domain = SegmentDomain(segment, varying, low, high, fixed, len(runs), scope_diameters(runs), settings)
             self.domains_[segment] = domain
+            if set(varying) & set(TISSUE_INPUTS):  # the material's effect goes through mu0 and C11
+                varying_settings = [v for v in varying_settings if v not in ("material", MATERIAL_PARAMETERS)]
             if varying_settings:
                 self.notes_.append(f"{segment}: solver setting(s) {', '.join(varying_settings)} vary between runs; "
                                    "they are not inputs, so their effect shows up as scatter")
@@ -127,6 +141,10 @@ class SweepSurrogate:
                 self.models_[segment][target] = gp
                 self.cv_[segment][target] = cross_validate(gp, X, y[keep], self.cv, self._make_gp(domain),
                                                            self.random_state)
+        self.tissue_, note = ((self.tissue, None) if self.tissue is not None
+                              else TissueDistribution.from_runs(table[table["status"] == "ok"]))
+        if note and any(tissue_inputs(d) for d in self.domains_.values()):
+            self.notes_.append(note)
         if not any(self.models_.values()):
             reasons = "; ".join(f"{s} {t}: {why}" for s, d in self.skipped_.items() for t, why in d.items())
             raise ColonsimError(f"no model could be fitted ({reasons or 'no successful run in the segments asked for'})")
@@ -165,25 +183,36 @@ class SweepSurrogate:
                                        np.where(np.isnan(np.asarray(given, dtype=float)), from_names, given))
         return values
 
-    def predict(self, X, segment, target="final_deformation_cm", return_std=False, strict=False):
+    def predict(self, X, segment, target="final_deformation_cm", return_std=False, strict=False, return_split=False):
         """Predicted ``target`` for ``segment`` at the query ``X``.
 
         ``X``: a mapping input name -> scalar or array (``scope`` may name a scope), a DataFrame
         with those columns, or an (n, d) array in the order of ``domains_[segment].inputs``.
         Outside the training domain: :class:`OutOfDomainWarning`, or an error with ``strict``.
         Returns the mean (n,), and with ``return_std`` the standard deviation of a new simulation
-        result (trend + run-to-run scatter).
+        result (trend + run-to-run scatter). A query without the tissue inputs of a model that has
+        them is averaged over the tissue distribution (:mod:`colonsim.surrogate.tissue`);
+        ``return_split`` returns (mean, total sd, tissue sd, surrogate sd).
         """
         domain, gp = self.model_for(segment, target)
         if isinstance(X, np.ndarray):
             X = dict(zip(domain.inputs, np.atleast_2d(X).T))
         elif isinstance(X, pd.DataFrame):
             X = {c: X[c].to_numpy() for c in X.columns}
-        Xm, _, _ = domain.check(self.query(domain.segment, X), strict=strict)
-        return gp.predict(Xm, return_std=return_std)
+        query = self.query(domain.segment, X)
+        n = max([np.size(query[c]) for c in domain.inputs if query.get(c) is not None], default=1)
+        query, tissue = plan(domain, query, n, getattr(self, "tissue_", None), strict)
+        Xm, _, _ = domain.check(query, strict=strict)
+        if not return_split and (not tissue.modelled or tissue.given.all()):
+            return gp.predict(Xm, return_std=return_std)
+        mean, sd, sd_tissue, sd_surrogate = split_predict(gp, domain, Xm, tissue)
+        if return_split:
+            return mean, sd, sd_tissue, sd_surrogate
+        return (mean, sd) if return_std else mean
 
     def predict_frame(self, frame: pd.DataFrame, targets=None, segment=None, strict=False) -> pd.DataFrame:
-        """Batch prediction: one row per query row, per target its mean, std and 95 % interval.
+        """Batch prediction: one row per query row, per target its mean, std, 95 % interval and the
+        std's tissue and surrogate parts (tissue NaN where not modelled; ``tissue_note`` says how).
 
         ``frame`` holds input columns (and ``segment`` unless given). Targets a segment has no model
         of are NaN. Columns ``in_domain`` and ``domain_note`` say which rows extrapolate."""
@@ -195,16 +224,18 @@ class SweepSurrogate:
         frame = frame.assign(segment=frame["segment"].astype(str).str.strip().str.lower())
         targets = list(targets or self.targets)
         out = frame.copy()
-        out["in_domain"], out["domain_note"] = True, ""
+        out["in_domain"], out["domain_note"], out["tissue_note"] = True, "", ""
         for t in targets:
-            for suffix in ("", "_std", "_low95", "_high95"):
+            for suffix in SUFFIXES:
                 out[t + suffix] = np.nan
         for seg, rows in frame.groupby("segment", sort=False):
             if seg not in self.domains_:
                 raise ColonsimError(f"the surrogate has no model of segment {seg!r}; it was fitted on {', '.join(self.domains_)}")
             domain = self.domains_[seg]
             values = self.query(seg, {c: rows[c].to_numpy() for c in rows.columns if c != "segment"})
+            values, tissue = plan(domain, values, len(rows), getattr(self, "tissue_", None), strict)
             Xm, inside, note = domain.check(values, n=len(rows), strict=strict)
+            out.loc[rows.index, "tissue_note"] = tissue.note
             out.loc[rows.index, "in_domain"] = inside
             out.loc[rows.index, "domain_note"] = note
             if values.get("scope_diameter_mm") is not None:
@@ -213,9 +244,11 @@ class SweepSurrogate:
                 gp = self.models_[seg].get(t)
                 if gp is None:
                     continue
-                mean, std = gp.predict(Xm, return_std=True)
+                mean, std, std_tissue, std_surrogate = split_predict(gp, domain, Xm, tissue)
                 out.loc[rows.index, t] = mean
                 out.loc[rows.index, t + "_std"] = std
+                out.loc[rows.index, t + "_std_tissue"] = std_tissue
+                out.loc[rows.index, t + "_std_surrogate"] = std_surrogate
                 out.loc[rows.index, t + "_low95"] = mean - Z95 * std
                 out.loc[rows.index, t + "_high95"] = mean + Z95 * std
         return out
@@ -234,6 +267,9 @@ class SweepSurrogate:
                              f"scatter sd {gp.noise_std:.2g}  length scales ({scales})")
             for target, why in self.skipped_[seg].items():
                 lines.append(f"  {target:<22} no model: {why}")
+        if getattr(self, "tissue_", None) is not None and any(tissue_inputs(d) for d in self.domains_.values()):
+            lines.append(f"tissue: predictions without wall_mu0_kPa / wall_C11_kPa average over "
+                         f"{self.tissue_.description}")
         lines.extend(f"note: {n}" for n in self.notes_)
         if self.domains_:
             first = next(iter(self.cv_.values()), {})

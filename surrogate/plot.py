@@ -7,6 +7,7 @@ from matplotlib.figure import Figure
 
 from colonsim.errors import ColonsimError
 from colonsim.surrogate.recommend import default_scopes
+from colonsim.surrogate.tissue import tissue_inputs
 from colonsim.surrogate.table import INPUT_LABELS, TARGET_LABELS, scope_diameter_mm
 from colonsim.surrogate.validation import Z95
 
@@ -16,13 +17,20 @@ def prediction_figure(model, segment, vs, inputs: dict, target="final_deformatio
     """Predicted ``target`` of ``segment`` against the input ``vs`` over its training range.
 
     The other inputs come from ``inputs``; ``scopes`` (default: the sweep's named scopes) give one
-    curve each unless ``vs`` is the scope diameter. The band is the 95 % interval of a new
+    curve each unless ``vs`` is the scope diameter; tissue inputs not given are set to the tissue
+    distribution's mean (the title shows them). The band is the 95 % interval of a new
     simulation result. Training runs that share the other inputs are drawn as dots. Other inputs
     outside the training domain: a warning, or an error with ``strict``."""
     domain, gp = model.model_for(segment, target)
     if vs not in domain.inputs:
         raise ColonsimError(f"{domain.segment} does not depend on {vs} in this surrogate; plot against one of "
                             f"{', '.join(domain.inputs)}")
+    missing = [c for c in tissue_inputs(domain) if c != vs and inputs.get(c) is None]
+    if missing:  # a curve is for one tissue: the tissue distribution's mean unless given
+        if model.tissue_ is None:
+            raise ColonsimError(f"give {', '.join(missing)}: the surrogate holds no tissue distribution")
+        draws = model.tissue_.draws()
+        inputs = {**inputs, **{c: float(np.mean(draws[c])) for c in missing}}
     j = domain.inputs.index(vs)
     grid = np.linspace(domain.low[j], domain.high[j], points)
     fig = Figure(figsize=(6.4, 4.4))

@@ -11,6 +11,11 @@ the question is which scope deforms this colon less on average, not which of two
   SDC by default) = Phi((mu_ref - mu) / sqrt(var + var_ref - 2 cov)), exact for the Gaussian.
 - ``p_best``: P(this scope deforms least), and ``p_ranking``: P(the whole stated order holds),
   both from draws of the joint Gaussian.
+- a model with tissue inputs and a patient without them: the patient's tissue is unknown, so the
+  joint law is the mixture of these Gaussians over the tissue draws (:mod:`colonsim.surrogate.tissue`);
+  each scope's sd splits into a tissue part (the spread of the means over the draws) and a
+  surrogate part (the mean GP variance), and the probabilities are those of the mixture (the
+  tissue moves all scopes together, so it widens each level far more than the differences).
 
 Where the patient coincides with simulated cases, the posterior of the trend is nearly exact and
 the probabilities above approach 0 or 1: they then restate the simulations, not the surrogate's
@@ -25,6 +30,7 @@ import numpy as np
 from scipy.special import ndtr
 
 from colonsim.errors import ColonsimError
+from colonsim.surrogate.tissue import plan, trend_components
 from colonsim.surrogate.table import NAMED_SCOPES_MM, STANDARD_SCOPE, scope_diameter_mm, target_unit
 from colonsim.surrogate.validation import Z95
 
@@ -57,14 +63,21 @@ def recommend(model, segment, inputs: dict, scopes=None, target="final_deformati
         raise ColonsimError(f"reference scope {reference} is not among the scopes ranked ({', '.join(scopes)})")
     query = {k: v for k, v in inputs.items() if k not in ("scope", "scope_diameter_mm")}
     query["scope_diameter_mm"] = diameters
+    patient = {k: float(np.asarray(v)) for k, v in query.items() if k != "scope_diameter_mm"}
+    query, tissue = plan(domain, query, len(scopes), getattr(model, "tissue_", None), strict)
     X, inside, notes = domain.check(query, n=len(scopes), strict=strict)
-    mean, cov = gp.predict(X, return_cov=True)
+    # one Gaussian of the trend per tissue draw (one in all without averaging): a mixture over the tissue
+    means, covs = trend_components(gp, domain, X, tissue)
+    mean, surrogate_cov = means.mean(axis=0), covs.mean(axis=0)
+    tissue_cov = (means - mean).T @ (means - mean) / len(means)
+    cov = surrogate_cov + tissue_cov
     var = np.maximum(np.diag(cov), 0.0)
     r = scopes.index(reference)
-    diff_sd = np.sqrt(np.maximum(var + var[r] - 2.0 * cov[:, r], 1e-300))
-    p_less = ndtr((mean[r] - mean) / diff_sd)
+    component_var = np.maximum(np.diagonal(covs, axis1=1, axis2=2), 0.0)
+    diff_sd = np.sqrt(np.maximum(component_var + component_var[:, [r]] - 2.0 * covs[:, :, r], 1e-300))
+    p_less = ndtr((means[:, [r]] - means) / diff_sd).mean(axis=0)
     order = np.argsort(mean, kind="stable")
-    draws = np.random.default_rng(seed).multivariate_normal(mean, cov, size=n_draws, method="eigh")
+    draws = _mixture_draws(means, covs, n_draws, seed)
     p_best = np.bincount(np.argmin(draws, axis=1), minlength=len(scopes)) / n_draws
     p_ranking = float(np.mean(np.all(np.diff(draws[:, order], axis=1) > 0, axis=1)))
     cv_rmse = float(model.cv_[domain.segment][target]["rmse"])
@@ -72,18 +85,31 @@ def recommend(model, segment, inputs: dict, scopes=None, target="final_deformati
     p_ranking_cv = float(np.mean(np.all(np.diff(noisy[:, order], axis=1) > 0, axis=1)))
     p_less_cv = np.mean(noisy < noisy[:, [r]], axis=0)
     std = np.sqrt(var)
+    std_tissue = np.sqrt(np.maximum(np.diag(tissue_cov), 0.0)) if tissue.modelled else np.full(len(scopes), np.nan)
+    std_surrogate = np.sqrt(np.maximum(np.diag(surrogate_cov), 0.0))
     rows = [{"scope": scopes[i], "diameter_mm": float(diameters[i]), "rank": int(np.flatnonzero(order == i)[0]) + 1,
-             "mean": float(mean[i]), "std": float(std[i]), "low95": float(mean[i] - Z95 * std[i]),
+             "mean": float(mean[i]), "std": float(std[i]),
+             "std_tissue": None if np.isnan(std_tissue[i]) else float(std_tissue[i]),
+             "std_surrogate": float(std_surrogate[i]), "low95": float(mean[i] - Z95 * std[i]),
              "high95": float(mean[i] + Z95 * std[i]), "p_best": float(p_best[i]),
              "p_less_than_reference": None if i == r else float(p_less[i]),
              "p_less_than_reference_with_cv_error": None if i == r else float(p_less_cv[i]),
              "in_domain": bool(inside[i]), "domain_note": notes[i]} for i in order]
-    return {"segment": domain.segment, "target": target, "inputs": {k: float(np.asarray(v)) for k, v in query.items()
-                                                                   if k != "scope_diameter_mm"},
+    return {"segment": domain.segment, "target": target, "inputs": patient,
             "reference": reference, "ranking": [scopes[i] for i in order], "p_ranking": p_ranking,
             "cv_rmse": cv_rmse, "p_ranking_with_cv_error": p_ranking_cv, "scopes": rows,
             "uncertainty": "joint GP posterior of the smooth trend at the scopes (covariance included); "
-                           "run-to-run scatter excluded", "in_domain": bool(inside.all())}
+                           "run-to-run scatter excluded", "in_domain": bool(inside.all()), "tissue": tissue.to_dict()}
+
+
+def _mixture_draws(means, covs, n_draws, seed):
+    """``n_draws`` draws of the equally weighted mixture of Gaussians (means[k], covs[k])."""
+    rng = np.random.default_rng(seed)
+    if len(means) == 1:
+        return rng.multivariate_normal(means[0], covs[0], size=n_draws, method="eigh")
+    counts = np.bincount(np.arange(n_draws) % len(means), minlength=len(means))
+    return np.concatenate([rng.multivariate_normal(m, c, size=k, method="eigh")
+                           for m, c, k in zip(means, covs, counts) if k])
 
 
 def format_recommendation(rec) -> str:
@@ -100,5 +126,12 @@ def format_recommendation(rec) -> str:
         lines.append(f"  {s['rank']}. {s['scope'].upper():>5} ({s['diameter_mm']:g} mm): {s['mean']:.3g} {unit} "
                      f"[95 % {s['low95']:.3g}, {s['high95']:.3g}]  P(least) {100 * s['p_best']:.0f} %{vs}"
                      + ("" if s["in_domain"] else f"  OUTSIDE the training domain: {s['domain_note']}"))
+    tissue = rec["tissue"]
+    if not tissue["modelled"]:
+        lines.append(f"  uncertainty: surrogate only; {tissue['note']}")
+    else:
+        split = ", ".join(f"{s['scope'].upper()} tissue {s['std_tissue']:.2g}, surrogate {s['std_surrogate']:.2g}"
+                          for s in rec["scopes"])
+        lines.append(f"  uncertainty split (sd, {unit}): {split}; {tissue['note']}")
     lines.append(f"  ({rec['uncertainty']})")
     return "\n".join(lines)

@@ -1,8 +1,8 @@
 """Save a fitted surrogate to open files and load it back without pickle.
 
 ``MODEL.json`` (readable): format and version, the estimator's settings, per segment the training
-domain, per output the kernel hyperparameters, scaling, cross-validation metrics, and the name and
-SHA-256 of the arrays file. ``MODEL.npz`` (numpy arrays, read with ``allow_pickle=False``): per
+domain, per output the kernel hyperparameters, scaling, cross-validation metrics, the tissue
+distribution predictions average over, and the name and SHA-256 of the arrays file. ``MODEL.npz`` (numpy arrays, read with ``allow_pickle=False``): per
 segment and output the scaled training inputs, the standardized training outputs, ``alpha`` =
 K^-1 y and the lower Cholesky factor L of K. That is everything prediction needs: loading neither
 refits nor imports scikit-learn.
@@ -24,9 +24,10 @@ from colonsim.files import atomic_paths, json_text
 from colonsim.surrogate.domain import SegmentDomain
 from colonsim.surrogate.gp import GaussianProcess
 from colonsim.surrogate.model import SweepSurrogate
+from colonsim.surrogate.tissue import TissueDistribution
 
 FORMAT = "colonsim-surrogate"
-FORMAT_VERSION = "1.0"
+FORMAT_VERSION = "1.1"
 ARRAYS = ("X_train", "y_train", "alpha", "L")
 
 
@@ -73,7 +74,8 @@ def save_surrogate(model: SweepSurrogate, path, source=None):
                          "segments": None if model.segments is None else list(model.segments), "cv": model.cv,
                          "n_restarts": model.n_restarts, "min_runs": model.min_runs, "random_state": model.random_state,
                          "threads": model.threads},
-           "training": model.training_, "notes": model.notes_, "segments": segments}
+           "training": model.training_, "notes": model.notes_, "segments": segments,
+           "tissue": None if model.tissue_ is None else model.tissue_.to_dict()}
     bad = next((k for k, a in arrays.items() if not np.isfinite(a).all()), None)
     if bad is not None:
         raise ColonsimError(f"cannot save the surrogate: array {bad} is not finite; nothing was written")
@@ -121,6 +123,7 @@ def _read_pair(doc, json_path, npz_path) -> SweepSurrogate:
                                cv=est["cv"], n_restarts=est["n_restarts"], min_runs=est["min_runs"],
                                random_state=est["random_state"], threads=est.get("threads", 1))
         model.training_, model.notes_ = doc["training"], list(doc["notes"])
+        model.tissue_ = TissueDistribution.from_dict(doc.get("tissue"))  # files of format 1.0 hold none
         model.domains_, model.models_, model.cv_, model.skipped_ = {}, {}, {}, {}
         with np.load(npz_path, allow_pickle=False) as arrays:
             for seg, entry in doc["segments"].items():

@@ -110,13 +110,16 @@ def _constant(values: pd.Series) -> bool:
 def split_inputs(runs: pd.DataFrame, inputs=INPUTS):
     """Which candidate inputs vary over ``runs`` (the model's inputs) and which are fixed (value).
 
-    Inputs absent from the table are neither: a query may not set them."""
+    Inputs absent from the table, or undefined (NaN) in every run (C11 of a law without it), are
+    neither: a query may not set them."""
     varying, fixed = [], {}
     for name in inputs:
-        if name not in runs.columns:
+        if name not in runs.columns or runs[name].isna().all():
             continue
         if runs[name].isna().any():
-            raise ColonsimError(f"input column {name} has missing values in successful runs; fix the sweep table")
+            raise ColonsimError(f"input column {name} has missing values in {int(runs[name].isna().sum())} of "
+                                f"{len(runs)} successful runs (rows of an older colonsim, or wall laws with and without "
+                                "that term); fit runs that all have it")
         if _constant(runs[name]):
             fixed[name] = float(runs[name].iloc[0])
         else:

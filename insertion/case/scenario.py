@@ -41,7 +41,8 @@ from colonsim.provenance import code_version
 from colonsim.insertion.anatomy.colon_segments import colon_geometry
 from colonsim.insertion.engine.contact import RodShellContact
 from colonsim.insertion.anatomy.manoeuvre import PushProfile, continuous_push, straighten_relax_push
-from colonsim.insertion.engine.material import REFERENCE_MATERIAL_PATH, load_material
+from colonsim.insertion.engine.material import REFERENCE_MATERIAL_PATH
+from colonsim.insertion.case.case_material import case_material
 from colonsim.insertion.case.outcomes import JAM_PROGRESS, JAM_PUSH, characteristic_points, quasi_static_fraction
 from colonsim.insertion.case.recording import InsertionRecorder
 from colonsim.insertion.anatomy.scopes import colonoscope
@@ -90,6 +91,9 @@ class InsertionCase:
         Simulated time between recorded samples.
     time_step_factor : float
         Safety factor on the stable time step.
+    material_parameters : dict or None
+        {name: Pa} replacing the parameters of ``material`` (its law stays); set by a sweep's
+        ``[material]`` section (:mod:`colonsim.insertion.study.material_samples`). None = the file's.
     """
 
     segment: str = "rsj"
@@ -111,6 +115,7 @@ class InsertionCase:
     scope_damping: float = 5.0
     record_interval_s: float = 1e-3
     time_step_factor: float = 0.9
+    material_parameters: dict | None = None
 
     def validate(self):
         """Raise :class:`ColonsimError` naming the first bad input and its fix."""
@@ -140,13 +145,18 @@ class InsertionCase:
             raise ColonsimError(f"element size {self.element_size_mm} mm is too coarse for a {self.diameter_mm} mm colon; "
                                 "use at most a third of the diameter")
         colonoscope(self.scope).check_fits(self.diameter_mm * 1e-3)
+        if self.material_parameters is not None:
+            case_material(self.material, self.material_parameters)
 
     def to_dict(self) -> dict:
         return asdict(self)
 
     def key(self) -> str:
         """A short hash of the inputs (identifies a run in sweeps and output folders)."""
-        return hashlib.sha256(json.dumps(self.to_dict(), sort_keys=True).encode()).hexdigest()[:12]
+        inputs = self.to_dict()
+        if inputs["material_parameters"] is None:  # keys of cases without drawn materials stay as they were
+            del inputs["material_parameters"]
+        return hashlib.sha256(json.dumps(inputs, sort_keys=True).encode()).hexdigest()[:12]
 
 
 @dataclass
@@ -176,7 +186,7 @@ def build_insertion(case: InsertionCase) -> Insertion:
     D = case.diameter_mm * 1e-3
     geometry = colon_geometry(case.segment, D, case.angle_deg, case.element_size_mm * 1e-3,
                               case.wall_thickness_mm * 1e-3, case.exit_length_mm * 1e-3, case.flexure_angle_deg)
-    material = load_material(case.material or REFERENCE_MATERIAL_PATH)
+    material = case_material(case.material, case.material_parameters)
     shell = Shell(geometry.nodes, geometry.triangles, case.wall_thickness_mm * 1e-3, material,
                   density=COLON_DENSITY, name="colon")
 

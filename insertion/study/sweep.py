@@ -41,6 +41,7 @@ from colonsim.provenance import code_version
 from colonsim.insertion.case.run_budget import DEFAULT_MAX_STEPS, check_sweep_budget
 from colonsim.insertion.case.scenario import InsertionCase, InsertionResult
 from colonsim.insertion.anatomy.scopes import colonoscope
+from colonsim.insertion.study.material_samples import material_columns
 from colonsim.insertion.study.sweep_worker import execute, start_worker
 
 TABLE = "results.parquet"
@@ -53,8 +54,8 @@ OUTPUTS = catalog.columns(catalog.OUTPUT)
 
 
 def input_columns() -> list:
-    """Every InsertionCase field (from the dataclass) and the derived scope diameter."""
-    return [f.name for f in dataclasses.fields(InsertionCase)] + ["scope_diameter_mm"]
+    """Every InsertionCase field (from the dataclass), the derived scope diameter and wall moduli."""
+    return [f.name for f in dataclasses.fields(InsertionCase)] + ["scope_diameter_mm", catalog.WALL_MU0, catalog.WALL_C11]
 
 
 def _inputs(case) -> dict:
@@ -65,6 +66,7 @@ def _inputs(case) -> dict:
             value = "" if "str" in str(f.type) else math.nan
         row[f.name] = value
     row["scope_diameter_mm"] = round(colonoscope(case.scope).diameter * 1e3, 6)  # 11.3, not 11.299999999999999
+    row.update(material_columns(case))  # drawn parameters as JSON text, mu0 and C11 in kPa
     return row
 
 

@@ -42,6 +42,8 @@ or, for a space-filling design crossed with a grid (2 x 20 runs)::
 - Values are rounded to 3 decimals in the hypercube so that tables stay readable; the seed makes
   the sample (and so every run's key) reproducible.
 - Cases that come out identical (same :meth:`InsertionCase.key`) run once.
+- A ``[material]`` section crosses every case with wall materials drawn from a calibration
+  (:mod:`colonsim.insertion.study.material_samples`).
 
 Every case is validated before anything runs; errors are one line naming the key and the fix.
 Numbers must be finite (TOML allows ``inf`` and ``nan``), a sweep must vary something (``[fixed]``
@@ -64,6 +66,7 @@ import numpy as np
 from colonsim.catalog import NAMED_SCOPES
 from colonsim.errors import ColonsimError
 from colonsim.insertion.case.scenario import InsertionCase
+from colonsim.insertion.study.material_samples import MATERIAL_PARAMETERS, sample_materials
 
 if sys.version_info >= (3, 11):
     import tomllib
@@ -71,7 +74,7 @@ else:  # pragma: no cover
     import tomli as tomllib
 
 SCOPE_DIAMETER = "scope_diameter_mm"
-SECTIONS = ("sweep", "fixed", "grid", "lhs")
+SECTIONS = ("sweep", "fixed", "grid", "lhs", "material")
 SWEEP_KEYS = ("name", "seed", "description")
 LHS_DECIMALS = 3
 MAX_RUNS = 20_000  # ~3 s to expand and validate; 28 hours of computing at the fastest runs measured
@@ -253,7 +256,7 @@ def _number(name, value, where):
 
 
 def _axis_keys(table, where):
-    known = [*case_fields(), SCOPE_DIAMETER]
+    known = [k for k in (*case_fields(), SCOPE_DIAMETER) if k != MATERIAL_PARAMETERS]  # drawn by [material]
     for key in table:
         if key not in known:
             _unknown(key, where, known)
@@ -394,6 +397,7 @@ def parse_sweep(text: str, base: Path | None = None, origin: str = "sweep") -> S
         if case.key() not in seen:
             seen.add(case.key())
             cases.append(case)
+    cases = sample_materials(doc, cases, base, seed, MAX_RUNS)
     _check_materials(cases)
     return SweepSpec(name=name.strip(), seed=seed, description=str(head.get("description", "")), cases=cases,
                      source=text)
