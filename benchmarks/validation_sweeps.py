@@ -86,9 +86,11 @@ def _row_case(row) -> InsertionCase:
     """The case of a table row (its input columns)."""
     values = {}
     for f in dataclasses.fields(InsertionCase):
+        if f.name not in row.index:  # a table of older code: the field did not exist, its default ran
+            continue
         v = row[f.name]
-        if f.name == "material":
-            v = v if isinstance(v, str) and v else None
+        if f.default is None:  # optional inputs: "" in the table means absent; dicts are JSON text
+            v = (json.loads(v) if "dict" in str(f.type) else v) if isinstance(v, str) and v else None
         elif isinstance(f.default, float):
             v = float(v)
         values[f.name] = v
