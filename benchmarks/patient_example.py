@@ -25,18 +25,20 @@ SPACING = 0.015  # m between the file's points
 
 # (name, label, lumen diameter mm, pieces): lengths in m, angles in degrees, roll in degrees
 SEGMENTS = [
-    ("rectum", "fixed", 40.0, [("straight", 0.04), ("arc", 0.08, 40.0, 0.0), ("straight", 0.035)]),
-    ("sigmoid", "mobile", 35.0, [("arc", 0.05, 60.0, 90.0), ("straight", 0.02), ("arc", 0.045, 150.0, 120.0),
+    ("rectum", "fixed", 45.0, [("straight", 0.04), ("arc", 0.08, 40.0, 0.0), ("straight", 0.035)]),
+    ("sigmoid", "mobile", 40.0, [("arc", 0.05, 60.0, 90.0), ("straight", 0.02), ("arc", 0.045, 150.0, 120.0),
                                  ("straight", 0.01), ("arc", 0.05, 70.0, 240.0)]),
-    ("descending", "fixed", 40.0, [("arc", 0.06, 40.0, 180.0), ("straight", 0.08)]),
+    ("descending", "fixed", 45.0, [("arc", 0.06, 40.0, 180.0), ("straight", 0.08)]),
 ]
 HEADER = """\
 # Example anatomy for colonsim (NOT a patient): rectum, sigmoid loop and start of the descending colon.
 # Built by benchmarks/patient_example.py from straight and arc pieces; sources and assumptions in
 # data/README.md ("anatomy/"). Axes: x to the patient's left, y anterior, z cranial; mm; anal verge at 0.
-# rectum {rectum:.0f} cm fixed (MRI: sigmoid take-off 12.6 +- 1.8 cm from the anal verge), lumen 40 mm (assumption)
-# sigmoid ~{sigmoid:.0f} cm mobile (anatomy texts: about 25 cm; lumen 4-5 cm distended; 35 mm here, an assumption)
-# descending colon start {descending:.0f} cm fixed (assumption: 10-15 cm of the fixed colon the scope enters)
+# rectum {rectum:.0f} cm, fixed: the sigmoid take-off lies 12.6 +- 1.8 cm from the anal verge (MRI, 100 patients,
+#   Colorectal Dis. 2018, doi:10.1111/codi.14398); lumen 45 mm (assumption: no rectal diameter found)
+# sigmoid {sigmoid:.0f} cm, mobile: about 25 cm long, about 5 cm wide (anatomy texts); descending and sigmoid colon
+#   4-5 cm when distended (radiology texts): lumen 40 mm; its 3-D loop shape is an assumption
+# descending colon {descending:.0f} cm, fixed, lumen 45 mm (4-5 cm, as above); its length here is an assumption
 """
 
 
@@ -57,7 +59,8 @@ def build_points():
         s0, s1 = c.bounds(name)
         n = max(2, int(round((s1 - s0) / SPACING)))
         for k, s in enumerate(np.linspace(s0, s1, n + 1)[:-1] if name != SEGMENTS[-1][0] else np.linspace(s0, s1, n + 1)):
-            rows.append((c.position(s) * 1e3, label if k == 0 else "", diameter if k == 0 else None, name if k == 0 else ""))
+            # the diameter at every point: blank cells would be interpolated between the ranges
+            rows.append((c.position(s) * 1e3, label if k == 0 else "", diameter, name if k == 0 else ""))
     return c, rows
 
 

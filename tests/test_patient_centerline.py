@@ -206,6 +206,6 @@ def test_the_bundled_example_reads_and_meshes():
     assert [p.tag for p in c.pieces] == ["fixed", "mobile", "fixed"]
     assert 0.40 < c.length < 0.60 and c.median_diameter_mm is not None
     g = colon_geometry("patient", c.median_diameter_mm * 1e-3, 0.0, 0.006, 0.002, centerline=c)
-    assert g.mobile.any() and g.summary()["lumen_diameter_mm"]["min"] == pytest.approx(35.0)
-    with pytest.raises(ColonsimError, match="set the case's diameter_mm = 38.3"):
+    assert g.mobile.any() and g.summary()["lumen_diameter_mm"]["min"] == pytest.approx(40.0)
+    with pytest.raises(ColonsimError, match="set the case's diameter_mm = 45"):
         colon_geometry("patient", 0.036, 0.0, 0.006, 0.002, centerline=c)
