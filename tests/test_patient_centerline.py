@@ -3,6 +3,7 @@ curves, rotation-minimising frames, labelled ranges, diameter profiles and the t
 
 import numpy as np
 import pytest
+from centerline_files import hairpin, loop
 
 from colonsim.data import data_path
 from colonsim.errors import ColonsimError
@@ -148,23 +149,14 @@ def test_frames_are_orthonormal_and_do_not_twist():
 # -- the tube: bends, clashes, labelled nodes, diameter profile ----------------------------------
 
 def test_a_bend_tighter_than_the_tube_names_where(tmp_path):
-    theta = np.linspace(0.0, np.pi, 12)
-    rows = [(0, y, 0) for y in range(0, 60, 10)] + [(-12 + 12 * np.cos(a), 60 + 12 * np.sin(a), 0) for a in theta[1:]]
-    text = "x_mm,y_mm,z_mm,label\n" + "\n".join(f"{x:.3f},{y:.3f},{z},{'mobile' if i == 0 else ''}"
-                                                for i, (x, y, z) in enumerate(rows))
-    c = load_patient_centerline(_write(tmp_path, text))
+    c = load_patient_centerline(_write(tmp_path, hairpin()))
     with pytest.raises(ColonsimError, match=r"bends with radius .* mm at .* cm \(near line .*tighter than the colon "
                                             r"wall's outer surface.*raise the smoothing tolerance"):
         colon_geometry("patient", 0.036, 0.0, 0.004, 0.002, centerline=c)
 
 
 def test_a_tube_cutting_itself_names_both_places(tmp_path):
-    # a loop of radius 3 cm whose ends pass 2 cm apart
-    theta = np.linspace(0.0, 1.9 * np.pi, 40)
-    rows = [(30 * np.sin(a), 30 - 30 * np.cos(a), 0.0) for a in theta]
-    text = "x_mm,y_mm,z_mm,label\n" + "\n".join(f"{x:.3f},{y:.3f},{z},{'mobile' if i == 0 else ''}"
-                                                for i, (x, y, z) in enumerate(rows))
-    c = load_patient_centerline(_write(tmp_path, text))
+    c = load_patient_centerline(_write(tmp_path, loop()))
     with pytest.raises(ColonsimError, match=r"the tube cuts itself: the centerline at .* cm \(near line \d+\) passes "
                                             r".* mm from itself at .* cm \(near line \d+\)"):
         colon_geometry("patient", 0.030, 0.0, 0.004, 0.002, centerline=c)

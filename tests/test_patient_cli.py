@@ -7,6 +7,7 @@ import shutil
 import numpy as np
 import pandas as pd
 import pytest
+from centerline_files import PLAIN, hairpin, loop
 
 from colonsim.cli import main
 from colonsim.data import data_path
@@ -16,7 +17,6 @@ from colonsim.insertion.study.sweep_spec import parse_sweep
 
 EXAMPLE = data_path("anatomy", "sigmoid_loop.csv")
 HEADER = "x_mm,y_mm,z_mm,label,diameter_mm\n"
-PLAIN = "x_mm,y_mm,z_mm,label\n"
 
 
 def _rsj_like(diameters=("", "", "")):
@@ -31,22 +31,10 @@ def _rsj_like(diameters=("", "", "")):
     return HEADER + "".join(f"{x:.3f},{y:.3f},{z},{label},{d}\n" for x, y, z, label, d in rows)
 
 
-def _hairpin():
-    theta = np.linspace(0.0, np.pi, 12)
-    rows = [(0, y, 0) for y in range(0, 60, 10)] + [(-12 + 12 * np.cos(a), 60 + 12 * np.sin(a), 0) for a in theta[1:]]
-    return PLAIN + "".join(f"{x:.3f},{y:.3f},{z},{'mobile' if i == 0 else ''}\n" for i, (x, y, z) in enumerate(rows))
-
-
-def _loop():
-    theta = np.linspace(0.0, 1.9 * np.pi, 40)
-    return PLAIN + "".join(f"{30 * np.sin(a):.3f},{30 - 30 * np.cos(a):.3f},0,{'mobile' if i == 0 else ''}\n"
-                            for i, a in enumerate(theta))
-
-
 @pytest.fixture
 def files(tmp_path):
     texts = {"good.csv": _rsj_like(), "profile.csv": _rsj_like(("40", "30", "40")),
-             "narrow.csv": _rsj_like(("30", "12", "30")), "hairpin.csv": _hairpin(), "loop.csv": _loop(),
+             "narrow.csv": _rsj_like(("30", "12", "30")), "hairpin.csv": hairpin(), "loop.csv": loop(),
              "few.csv": PLAIN + "0,0,0,mobile\n0,10,0,\n",
              "no_units.csv": "x,y,z,label\n0,0,0,mobile\n", "cm.csv": "x_cm,y_cm,z_cm,label\n0,0,0,mobile\n",
              "fixed_only.csv": _rsj_like().replace("mobile", "fixed"),
