@@ -96,7 +96,7 @@ def draw_figure(folders):
         summary = json.loads((folder / "summary.json").read_text())
         case = InsertionCase(**summary["inputs"])
         model = build_insertion(case)
-        shape = read_final_shape(folder / "final_shape.npz")
+        shape = read_final_shape(folder)
         x0, x = model.shell.x0 * 100, shape["colon_m"] * 100
         disp = np.linalg.norm(x - x0, axis=1)
         scope = shape["scope_m"] * 100

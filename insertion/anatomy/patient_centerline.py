@@ -3,11 +3,14 @@ smoothed into a C2 curve, arc-length parametrised, with rotation-minimising fram
 
 docs/model.md, "A patient's centerline", states the choices (**assumptions** marked):
 
-- a parametric cubic smoothing spline (FITPACK ``splprep``, so C2) through the points,
-  parametrised by chord length, whose root-mean-square distance from the points is at most the
-  smoothing tolerance (**assumption** 1 mm by default, about the voxel of CT colonography:
-  0.6-0.8 mm in plane, 1-1.25 mm slices; ``centerline_smoothing_mm``). Segmentation noise of a
-  voxel would otherwise show as bends of a few mm radius that no tube can follow;
+- cubic smoothing splines x(u), y(u), z(u) of the chord-length parameter (scipy's
+  ``make_smoothing_spline``, one penalty weight, so the curve is C2) whose root-mean-square
+  distance from the points is the smoothing tolerance (**assumption** 1 mm by default, about the
+  voxel of CT colonography: 0.6-0.8 mm in plane, 1-1.25 mm slices; ``centerline_smoothing_mm``).
+  Segmentation noise of a voxel would otherwise show as bends of a few mm radius that no tube
+  can follow. (A penalised spline keeps a knot at every point and spreads the smoothing along
+  the curve; FITPACK's ``splprep`` meets a tolerance by dropping knots, which made the bend radius
+  of a sampled arc wander more in a first trial);
 - arc length by Gauss-Legendre quadrature of the spline's speed on a table of parameter values
   at most :data:`TABLE_STEP` apart, inverted by a cubic spline;
 - frames by the double-reflection method (Wang, Juettler, Zheng & Liu 2008, ACM Trans. Graph.
@@ -31,7 +34,7 @@ from colonsim.insertion.anatomy.centerline import MAX_LENGTH, LabelledCenterline
 from colonsim.insertion.anatomy.centerline_file import load_centerline_points, read_centerline_points
 
 SMOOTHING_MM = 1.0  # assumption: RMS distance of the smoothed centerline from the points, ~ a CT voxel
-SMOOTHING_RANGE_MM = (0.0, 20.0)
+SMOOTHING_RANGE_MM = (0.0, 20.0)  # beyond 2 cm the "centerline" would no longer follow the colon
 TABLE_STEP = 5e-4  # m, spacing of the arc-length and frame table
 _GAUSS = np.polynomial.legendre.leggauss(4)
 
@@ -59,10 +62,11 @@ def _double_reflection(x0, t0, r0, x1, t1):
     return r1 / np.linalg.norm(r1, axis=1)[:, None]
 
 
-def _smooth(u, p, tolerance, scale):
+def _smooth(u, p, tolerance):
     """Cubic smoothing splines x(u), y(u), z(u) (one penalty weight for all three) whose RMS
-    distance from the points ``p`` (n, 3) is ``tolerance`` (m), or which interpolate them when
-    they lie closer than that anyway; the weight is found by bisection on its logarithm."""
+    distance from the points ``p`` (n, 3) is ``tolerance`` (m), found by bisection on the
+    logarithm of the weight (the straightest fit when the points lie that close to a line;
+    interpolation for a tolerance of 0)."""
     def fit(lam):
         return [make_smoothing_spline(u, p[:, k], lam=lam) for k in range(3)]
 
@@ -118,8 +122,8 @@ class PatientCenterline(LabelledCenterline):
         chord = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(p, axis=0), axis=1))])
         n = len(p)
         u = chord / chord[-1]
-        self._spline = _smooth(u, p, smoothing_mm * 1e-3, chord[-1])
-        # arc-length table: Gauss-Legendre on intervals of the parameter at most TABLE_STEP long (chord scale)
+        self._spline = _smooth(u, p, smoothing_mm * 1e-3)
+        # arc-length table: Gauss-Legendre on parameter intervals of at most TABLE_STEP of chord
         m = max(int(np.ceil(chord[-1] / TABLE_STEP)), 4 * n)
         u_tab = np.linspace(0.0, 1.0, m + 1)
         nodes, weights = _GAUSS
