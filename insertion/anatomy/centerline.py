@@ -21,7 +21,10 @@ tangent, so rings of a tube mesh placed with ``(n, b)`` do not twist. On a plana
 positive angle towards ``+n``), which is how a 3-D centerline is built.
 
 The centerlines of the study's colon models are built from these pieces in
-:mod:`colonsim.insertion.anatomy.colon_centerlines`.
+:mod:`colonsim.insertion.anatomy.colon_centerlines`. :class:`LabelledCenterline` is what the
+mesher and the colon models use of any centerline (labelled ranges, frames, the self-clearance
+check); a patient's measured centerline
+(:class:`colonsim.insertion.anatomy.patient_centerline.PatientCenterline`) shares it.
 """
 
 from __future__ import annotations
