@@ -31,6 +31,10 @@ FAR_END = "far end"
 # The run ends at the far end or when the scope's available length is pushed in, whichever first.
 FAR_END_OR_LENGTH = "far end or available length"
 PAST_JUNCTION = 0.02  # m, how far past the fixed end of the mobile piece a PAST_MOBILE_END run ends
+# A model without a scope length of its own (a patient's centerline) gets a scope this much longer
+# than the centerline (assumption; docs/model.md, "A patient's centerline"): room for the scope to
+# bow before its tip reaches the far end, and plus the length kept in the sheath.
+SCOPE_LENGTH_MARGIN = 0.20
 ANGLE_LIMITS_DEG = (0.0, 60.0)  # RSF alpha and THF beta; the source used 0, 30, 45
 _BUILDERS = "colonsim.insertion.anatomy.colon_segments"
 
@@ -46,8 +50,10 @@ class ColonModel:
     builder : str
         ``"module:function"``; the function takes (diameter, angle_deg, element_size,
         wall_thickness, exit_length, flexure_angle_deg) in SI and returns a ``ColonGeometry``.
-    scope_length : float
-        Length of the scope the source pushed into this model, m.
+    scope_length : float or None
+        Length of the scope the source pushed into this model, m; None: the centerline's length
+        plus :data:`SCOPE_LENGTH_MARGIN` plus the length kept in the sheath
+        (:meth:`scope_length_for`).
     angle : {"alpha", "beta", "none"}
         What ``angle_deg`` means for the geometry ("none": ignored).
     angle_limits_deg : (float, float) or None
@@ -59,18 +65,22 @@ class ColonModel:
     end_rule : {PAST_MOBILE_END, FAR_END, FAR_END_OR_LENGTH}
     surrogate_angle : bool
         The surrogate's patient presets set this model's angle (sex -> alpha or beta).
+    reads_centerline : bool
+        The geometry is a user's centerline CSV (``InsertionCase.centerline``); the builder then
+        also takes ``centerline=`` (a loaded centerline).
     """
 
     name: str
     title: str
     builder: str
-    scope_length: float
+    scope_length: float | None
     angle: str = NO_ANGLE
     angle_limits_deg: tuple | None = None
     manoeuvre: str = CONTINUOUS_PUSH
     mobile_piece: str | None = None
     end_rule: str = FAR_END
     surrogate_angle: bool = False
+    reads_centerline: bool = False
 
     def __post_init__(self):
         def bad(what):
@@ -78,7 +88,7 @@ class ColonModel:
 
         if ":" not in self.builder:
             bad(f"builder {self.builder!r} is not 'module:function'")
-        if not 0.0 < self.scope_length < 5.0:
+        if self.scope_length is not None and not 0.0 < self.scope_length < 5.0:
             bad(f"scope_length {self.scope_length!r} m is not a scope length")
         if self.angle not in (ALPHA, BETA, NO_ANGLE) or (self.angle == NO_ANGLE) != (self.angle_limits_deg is None):
             bad("give angle alpha or beta with angle_limits_deg, or angle none without")
@@ -99,6 +109,13 @@ class ColonModel:
     def must_reach_end(self) -> bool:
         """The scope must be long enough for the tip to reach the end plane (else the run is refused)."""
         return self.end_rule in (PAST_MOBILE_END, FAR_END)
+
+    def scope_length_for(self, centerline_length, sheath_reserve):
+        """The scope's length, m, for a centerline of ``centerline_length`` with ``sheath_reserve``
+        kept in the sheath (m): the catalog's, or sized to the centerline (``scope_length`` None)."""
+        if self.scope_length is not None:
+            return self.scope_length
+        return centerline_length + SCOPE_LENGTH_MARGIN + sheath_reserve
 
     def check_angle(self, angle_deg):
         """Raise if ``angle_deg`` is outside the angles this geometry builds (ignored without an angle)."""
@@ -123,6 +140,10 @@ COLON_MODELS = {m.name: m for m in (
                f"{_BUILDERS}:thf_fixed_geometry", 0.50, BETA, ANGLE_LIMITS_DEG, end_rule=FAR_END_OR_LENGTH),
     ColonModel("straight", "a 20 cm straight tube, a sanity case",
                f"{_BUILDERS}:straight_geometry", 0.30),
+    # a continuous push: the straighten-relax-push blocks lateral motion along straight mobile
+    # pieces, which a measured centerline does not have (docs/model.md, "A patient's centerline")
+    ColonModel("patient", "a patient's centerline from a CSV (--centerline)",
+               f"{_BUILDERS}:patient_geometry", None, end_rule=FAR_END_OR_LENGTH, reads_centerline=True),
 )}
 
 
@@ -314,6 +335,9 @@ COLUMNS = {c.name: c for c in (
            "--friction"),
     Column("wall_thickness_mm", _I, "mm", "colon wall thickness", SURROGATE_INPUT, "wall thickness [mm]",
            "--wall-thickness"),
+    Column("centerline", _I, "", "a patient's centerline CSV (segment patient; empty for the catalog's models)",
+           option="--centerline"),
+    Column("centerline_smoothing_mm", _S, "mm", "RMS tolerance of the smoothed patient centerline"),
     Column("material", _S, "", "material JSON (empty: the source's parameters)"),
     Column("material_parameters", _S, "Pa", "wall parameters drawn by a [material] section, {name: Pa} as JSON, "
                                              "replacing the material file's (empty: the file's)"),

@@ -92,9 +92,17 @@ def _add_insert(sub):
                                    "deformation, contact and push forces, tip motion and energies. Writes "
                                    "timeseries.csv, summary.json and insertion.png per scope, a comparison table "
                                    "and figure, and optional VTU files for ParaView.")
-    p.add_argument("--segment", default="rsj", help=f"colon model (default rsj): {catalog.segment_help()}")
+    p.add_argument("--segment", default=None, help=f"colon model (default rsj): {catalog.segment_help()}")
     p.add_argument("--scope", nargs="+", default=["sdc"], help=f"{catalog.scope_help()}; several allowed (default sdc)")
-    p.add_argument("--diameter", type=finite_float, default=36.0, help="colon inner diameter, mm (default 36)")
+    p.add_argument("--centerline", type=Path,
+                   help="a patient's centerline CSV (x_mm, y_mm, z_mm, label fixed/mobile, optional diameter_mm "
+                        "and name; docs/model.md); implies --segment patient")
+    p.add_argument("--centerline-smoothing", type=finite_float, default=None,
+                   help="RMS distance (mm) the smoothed centerline may keep from the file's points (default 1, "
+                        "about a CT voxel)")
+    p.add_argument("--diameter", type=finite_float, default=None,
+                   help="colon inner diameter, mm (default 36; with --centerline, the median of the file's "
+                        "diameter_mm column when it has one)")
     p.add_argument("--angle", type=finite_float, default=0.0, help=f"degrees (default 0): {catalog.angle_help()}")
     p.add_argument("--friction", type=finite_float, default=0.0, help="Coulomb friction scope/wall (default 0)")
     p.add_argument("--wall-thickness", type=finite_float, default=2.0, help="colon wall thickness, mm (default 2, an assumption)")
@@ -127,7 +135,10 @@ def cmd_insert(args):
             raise ColonsimError(f"--threads {args.threads} must lie in 1-{numba.config.NUMBA_NUM_THREADS} (the cores Numba sees)")
         numba.set_num_threads(args.threads)
 
-    cases = [InsertionCase(segment=args.segment, scope=scope, diameter_mm=args.diameter, angle_deg=args.angle,
+    from colonsim.workflows import patient_inputs
+
+    anatomy = patient_inputs(args.segment, args.centerline, args.diameter, args.centerline_smoothing)
+    cases = [InsertionCase(**anatomy, scope=scope, angle_deg=args.angle,
                            flexure_angle_deg=args.flexure_angle, friction=args.friction,
                            wall_thickness_mm=args.wall_thickness,
                            element_size_mm=args.element_size, material=args.material,

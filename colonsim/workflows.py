@@ -254,6 +254,33 @@ def _compare_laws(curve, options, per_eval, show, out: Path) -> list:
     return [comparison.chosen_result]
 
 
+def patient_inputs(segment, centerline, diameter_mm, smoothing_mm) -> dict:
+    """The anatomy fields of an :class:`InsertionCase` from the insert options (None: not given).
+
+    ``centerline`` implies segment ``patient``; its diameter is, unless given, the median of the
+    file's ``diameter_mm`` column (the profile that runs), else 36 mm. The smoothing tolerance
+    goes with a centerline only."""
+    from colonsim.catalog import COLON_MODELS, colon_model
+    from colonsim.insertion.case.scenario import InsertionCase
+
+    default = InsertionCase()
+    if centerline is None:
+        if smoothing_mm is not None:
+            raise ColonsimError("--centerline-smoothing goes with --centerline; drop it or give the centerline file")
+        return {"segment": segment or default.segment,
+                "diameter_mm": default.diameter_mm if diameter_mm is None else diameter_mm}
+    if segment is not None and not colon_model(segment).reads_centerline:
+        raise ColonsimError(f"--centerline is a patient's own colon; drop --segment {segment} (it has its own shape)")
+    from colonsim.insertion.anatomy.patient_centerline import load_patient_centerline
+
+    smoothing = default.centerline_smoothing_mm if smoothing_mm is None else smoothing_mm
+    if diameter_mm is None:
+        diameter_mm = load_patient_centerline(centerline, smoothing).median_diameter_mm or default.diameter_mm
+    patient = segment or next(name for name, model in COLON_MODELS.items() if model.reads_centerline)
+    return {"segment": patient, "centerline": str(Path(centerline).expanduser().resolve()),
+            "centerline_smoothing_mm": smoothing, "diameter_mm": diameter_mm}
+
+
 def insert(cases, out: Path, vtu=False, snapshot_every=0.02, show=True, max_steps=DEFAULT_MAX_STEPS):
     """Run each case, write its folder under ``out`` and a comparison; return the results.
 

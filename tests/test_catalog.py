@@ -12,6 +12,8 @@ import pytest
 
 from colonsim import catalog
 from colonsim.catalog import COLON_MODELS, COLUMNS, NAMED_SCOPES, ColonModel, NamedScope
+from colonsim.data import data_path
+from colonsim.insertion.anatomy.patient_centerline import load_patient_centerline
 from colonsim.errors import ColonsimError
 from colonsim.insertion.anatomy.colon_segments import colon_geometry
 from colonsim.insertion.anatomy.scopes import colonoscope
@@ -30,6 +32,17 @@ def _middle_angle(model):
     return 0.0 if model.angle_limits_deg is None else 0.5 * sum(model.angle_limits_deg)
 
 
+EXAMPLE_CENTERLINE = str(data_path("anatomy", "sigmoid_loop.csv"))
+
+
+def _anatomy(model):
+    """Case fields of ``model``'s geometry: a model that reads a centerline gets the bundled example."""
+    if not model.reads_centerline:
+        return {"diameter_mm": 36.0}
+    return {"centerline": EXAMPLE_CENTERLINE,
+            "diameter_mm": load_patient_centerline(EXAMPLE_CENTERLINE).median_diameter_mm}
+
+
 def _table(segments, scopes=("sdc",)):
     """A minimal results table as the surrogate reads it, one ok run per segment and scope."""
     rows = [{"key": f"{s}-{c}", "status": "ok", "segment": s, "scope": c, "scope_diameter_mm": scope_diameter_mm(c),
@@ -42,22 +55,28 @@ def _table(segments, scopes=("sdc",)):
 def test_every_colon_model_builds_and_its_facts_reach_the_case(name):
     model = COLON_MODELS[name]
     angle = _middle_angle(model)
-    g = colon_geometry(name, 0.036, angle, COARSE_MM * 1e-3, 2e-3)
+    anatomy = _anatomy(model)
+    centerline = load_patient_centerline(anatomy["centerline"]) if model.reads_centerline else None
+    g = colon_geometry(name, anatomy["diameter_mm"] * 1e-3, angle, COARSE_MM * 1e-3, 2e-3, centerline=centerline)
     assert g.name == name and len(g.triangles) > 0
     assert (g.straighten_depth is not None) == model.straightens
     if model.straightens:
         assert g.mobile_axes and g.straighten_depth == g.mobile_end
     assert (g.end_depth < g.centerline_length) == (model.end_rule == catalog.PAST_MOBILE_END)
-    built = build_insertion(InsertionCase(segment=name, angle_deg=angle, element_size_mm=COARSE_MM))
-    assert built.rod.rest_length.sum() == pytest.approx(model.scope_length, rel=1e-12)
+    case = InsertionCase(segment=name, angle_deg=angle, element_size_mm=COARSE_MM, **anatomy)
+    built = build_insertion(case)
+    length = model.scope_length_for(g.centerline_length, case.sheath_reserve_mm * 1e-3)
+    assert built.rod.rest_length.sum() == pytest.approx(length, rel=1e-12)
+    assert (model.scope_length is None) == model.reads_centerline
     phases = [p.name for p in built.push.phases]
     assert phases == (["straighten", "stop", "relax", "push"] if model.straightens else ["push"])
 
 
 def test_colon_model_facts_reach_sweep_and_surrogate():
     names = list(COLON_MODELS)
-    spec = parse_sweep(f'[grid]\nsegment = {names!r}\nelement_size_mm = {COARSE_MM}'.replace("'", '"'))
-    assert [c.segment for c in spec.cases] == names
+    shaped = [n for n in names if not COLON_MODELS[n].reads_centerline]  # the others need their file
+    spec = parse_sweep(f'[grid]\nsegment = {shaped!r}\nelement_size_mm = {COARSE_MM}'.replace("'", '"'))
+    assert [c.segment for c in spec.cases] == shaped
     table = check_results(_table([n.upper() for n in names]))
     assert list(table["segment"]) == names
     for name, model in COLON_MODELS.items():

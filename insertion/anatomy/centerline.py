@@ -21,7 +21,10 @@ tangent, so rings of a tube mesh placed with ``(n, b)`` do not twist. On a plana
 positive angle towards ``+n``), which is how a 3-D centerline is built.
 
 The centerlines of the study's colon models are built from these pieces in
-:mod:`colonsim.insertion.anatomy.colon_centerlines`.
+:mod:`colonsim.insertion.anatomy.colon_centerlines`. :class:`LabelledCenterline` is what the
+mesher and the colon models use of any centerline (labelled ranges, frames, the self-clearance
+check); a patient's measured centerline
+(:class:`colonsim.insertion.anatomy.patient_centerline.PatientCenterline`) shares it.
 """
 
 from __future__ import annotations
@@ -180,7 +183,75 @@ def resolve_pieces(pieces, fillet_radius=FILLET_RADIUS):
     return merged
 
 
-class Centerline:
+class LabelledCenterline:
+    """What every centerline offers the mesher and the colon models: arc length ``s`` (m) from 0 to
+    ``length``, :meth:`frame`, and labelled ranges ``pieces`` (each with ``.tag`` fixed/mobile and
+    ``.name``) covering ``[s_start, s_end)``. Subclasses set ``pieces``, ``s_start``, ``s_end``,
+    ``length`` and implement :meth:`frame`, :attr:`min_radius` and ``check_tube``.
+    """
+
+    def piece_index(self, s):
+        """Index of the piece holding arc length ``s`` (pieces are [start, end); the end belongs to the last)."""
+        s = np.asarray(s, dtype=float)
+        return np.clip(np.searchsorted(self.s_end, s, side="right"), 0, len(self.pieces) - 1)
+
+    def position(self, s):
+        """Point at arc length ``s`` (m), shape (3,) or (k, 3)."""
+        return self.frame(s)[0]
+
+    def tangent(self, s):
+        """Unit tangent at arc length ``s`` (m), shape (3,) or (k, 3)."""
+        return self.frame(s)[1]
+
+    def tag_at(self, s):
+        """``"fixed"`` or ``"mobile"`` at arc length ``s`` (str, or array of str)."""
+        tags = np.array([p.tag for p in self.pieces])[self.piece_index(s)]
+        return tags if np.ndim(s) else str(tags)
+
+    def name_at(self, s):
+        """Name of the piece at arc length ``s`` (str, or array of str)."""
+        names = np.array([p.name for p in self.pieces])[self.piece_index(s)]
+        return names if np.ndim(s) else str(names)
+
+    def bounds(self, name):
+        """Arc-length interval (s0, s1), m, covered by the pieces called ``name``."""
+        hits = [i for i, p in enumerate(self.pieces) if p.name == name]
+        if not hits:
+            known = ", ".join(dict.fromkeys(p.name for p in self.pieces))
+            raise ColonsimError(f"no piece called {name!r} in this centerline; use one of: {known}.")
+        return float(self.s_start[hits[0]]), float(self.s_end[hits[-1]])
+
+    def first_clash(self, diameter_at):
+        """Where a tube of diameter ``diameter_at(s)`` (m, vectorised) would cut itself, or None.
+
+        Two cross-sections further apart along s than ``pi D / 2`` (the longest stretch over which
+        a curve with bend radii >= D/2 can stay within D of its start; D the larger of the two)
+        must be at least their mean diameter apart; checked on a sampled centerline.
+
+        Returns
+        -------
+        (s_i, s_j, distance) or None
+            Arc lengths of the first clashing pair found and the distance of their centres, m.
+        """
+        d_min = float(np.min(diameter_at(np.linspace(0.0, self.length, 201))))
+        # Samples D/8 apart (capped, so a hair-thin tube on a long centerline stays affordable:
+        # the check then only sees clashes deeper than the sample spacing).
+        n = min(5_000, max(2, int(np.ceil(self.length / (0.125 * d_min))) + 1))
+        s = np.linspace(0.0, self.length, n)
+        p = self.position(s)
+        d = diameter_at(s)
+        for lo in range(0, n, 1000):  # blocks of rows bound the pairwise-distance memory
+            dist = np.linalg.norm(p[lo:lo + 1000, None, :] - p[None, :, :], axis=-1)
+            d_big = np.maximum(d[lo:lo + 1000, None], d[None, :])
+            far = np.abs(s[lo:lo + 1000, None] - s[None, :]) > 0.5 * np.pi * d_big
+            clash = far & (dist < 0.5 * (d[lo:lo + 1000, None] + d[None, :]) * (1.0 - 1e-9))
+            if np.any(clash):
+                i, j = np.argwhere(clash)[0]
+                return float(s[lo + i]), float(s[j]), float(dist[i, j])
+        return None
+
+
+class Centerline(LabelledCenterline):
     """Arc-length parametrised chain of straight and arc pieces (m), with a parallel-transport frame.
 
     Parameters
@@ -253,11 +324,6 @@ class Centerline:
         nor = _rotate(np.tile(n0, (len(sigma), 1)), self._w[i], theta)
         return pos, tan, nor
 
-    def piece_index(self, s):
-        """Index of the piece holding arc length ``s`` (pieces are [start, end); the end belongs to the last)."""
-        s = np.asarray(s, dtype=float)
-        return np.clip(np.searchsorted(self.s_end, s, side="right"), 0, len(self.pieces) - 1)
-
     def frame(self, s):
         """Position, unit tangent, normal and binormal at arc length ``s``.
 
@@ -283,32 +349,6 @@ class Centerline:
             return pos[0], tan[0], nor[0], binormal[0]
         return pos, tan, nor, binormal
 
-    def position(self, s):
-        """Point at arc length ``s`` (m), shape (3,) or (k, 3)."""
-        return self.frame(s)[0]
-
-    def tangent(self, s):
-        """Unit tangent at arc length ``s`` (m), shape (3,) or (k, 3)."""
-        return self.frame(s)[1]
-
-    def tag_at(self, s):
-        """``"fixed"`` or ``"mobile"`` at arc length ``s`` (str, or array of str)."""
-        tags = np.array([p.tag for p in self.pieces])[self.piece_index(s)]
-        return tags if np.ndim(s) else str(tags)
-
-    def name_at(self, s):
-        """Name of the piece at arc length ``s`` (str, or array of str)."""
-        names = np.array([p.name for p in self.pieces])[self.piece_index(s)]
-        return names if np.ndim(s) else str(names)
-
-    def bounds(self, name):
-        """Arc-length interval (s0, s1), m, covered by the pieces called ``name``."""
-        hits = [i for i, p in enumerate(self.pieces) if p.name == name]
-        if not hits:
-            known = ", ".join(dict.fromkeys(p.name for p in self.pieces))
-            raise ColonsimError(f"no piece called {name!r} in this centerline; use one of: {known}.")
-        return float(self.s_start[hits[0]]), float(self.s_end[hits[-1]])
-
     @property
     def min_radius(self):
         """Smallest bend radius, m (inf for a straight centerline)."""
@@ -329,19 +369,11 @@ class Centerline:
                 f"a {diameter * 1e3:.0f} mm tube does not fit a bend of radius {self.min_radius * 100:.1f} cm "
                 "(the wall folds at D/2 >= R); use a smaller diameter or a larger bend radius."
             )
-        # Samples D/8 apart (capped, so a hair-thin tube on a long centerline stays affordable:
-        # the check then only sees clashes deeper than the sample spacing).
-        n = min(5_000, max(2, int(np.ceil(self.length / (0.125 * diameter))) + 1))
-        s = np.linspace(0.0, self.length, n)
-        p = self.position(s)
-        for lo in range(0, n, 1000):  # blocks of rows bound the pairwise-distance memory
-            dist = np.linalg.norm(p[lo:lo + 1000, None, :] - p[None, :, :], axis=-1)
-            far = np.abs(s[lo:lo + 1000, None] - s[None, :]) > 0.5 * np.pi * diameter
-            clash = far & (dist < diameter * (1.0 - 1e-9))
-            if np.any(clash):
-                i, j = np.argwhere(clash)[0]
-                raise ColonsimError(
-                    f"a {diameter * 1e3:.0f} mm tube cuts itself between {self.name_at(s[lo + i])} and "
-                    f"{self.name_at(s[j])} (centerlines {dist[i, j] * 100:.1f} cm apart); "
-                    "use a smaller diameter or a smaller angle."
-                )
+        clash = self.first_clash(lambda s: np.full(np.shape(s), float(diameter)))
+        if clash is not None:
+            s_i, s_j, dist = clash
+            raise ColonsimError(
+                f"a {diameter * 1e3:.0f} mm tube cuts itself between {self.name_at(s_i)} and "
+                f"{self.name_at(s_j)} (centerlines {dist * 100:.1f} cm apart); "
+                "use a smaller diameter or a smaller angle."
+            )

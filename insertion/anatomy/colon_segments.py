@@ -19,7 +19,9 @@ their builders and applies those rules. It adds what an insertion run needs from
   piece it belongs to (``mobile_axes``): the sigmoid, or each transverse arm, each with its half of
   the V-bottom fillet;
 - the end rule sets ``end_depth``: ``PAST_JUNCTION`` (2 cm) past the fixed end of the mobile piece
-  (RSJ), else the centerline's far end.
+  (RSJ), else the centerline's far end;
+- a patient's centerline (``patient``) is the file's shape as it is: no exit is added, no angle
+  applies, and the lumen follows the file's diameter profile when it has one.
 
 :func:`colon_geometry` returns a :class:`ColonGeometry`. A straight tube (``"straight"``) is
 kept for sanity checks.
@@ -67,6 +69,8 @@ class ColonGeometry:
     mobile_end: float | None = None
     # the wall's tube mesh with its centerline (None for the straight tube)
     tube: object = None
+    # lumen diameter (min, median, max), m, of a diameter profile (None: constant diameter)
+    lumen_diameters: tuple | None = None
 
     def __post_init__(self):
         if self.end_depth is None:
@@ -76,7 +80,9 @@ class ColonGeometry:
         return {"segment": self.name, "wall_nodes": int(len(self.nodes)), "wall_triangles": int(len(self.triangles)),
                 "fixed_nodes": int(self.fixed.sum()), "mobile_nodes": int(self.mobile.sum()),
                 "end_ring_nodes": int(self.end_ring.sum()), "centerline_length_cm": self.centerline_length * 100,
-                "mobile_end_cm": None if self.mobile_end is None else self.mobile_end * 100}
+                "mobile_end_cm": None if self.mobile_end is None else self.mobile_end * 100,
+                **({} if self.lumen_diameters is None else
+                   {"lumen_diameter_mm": dict(zip(("min", "median", "max"), (d * 1e3 for d in self.lumen_diameters)))})}
 
 
 def _mobile_axes(centerline, mesh, name):
@@ -115,11 +121,18 @@ def mobile_end(centerline):
 
 
 def _tube_geometry(centerline, diameter, element_size, wall_thickness) -> ColonGeometry:
-    """The wall of ``centerline`` meshed at its mid-surface, with the mesh kept for the catalog's rules."""
-    if 0.5 * diameter + wall_thickness >= centerline.min_radius:
+    """The wall of ``centerline`` meshed at its mid-surface, with the mesh kept for the catalog's rules.
+
+    ``diameter`` is the lumen diameter, m, or a patient's profile ``D(s)``: the wall's outer
+    surface must clear every bend (D/2 + t below the bend radius)."""
+    if callable(diameter):
+        centerline.check_bend(lambda s: 0.5 * diameter(s) + wall_thickness, "the colon wall's outer surface")
+        mesh = tube_mesh(centerline, lambda s: diameter(s) + wall_thickness, element_size)
+    elif 0.5 * diameter + wall_thickness >= centerline.min_radius:
         raise ColonsimError(f"a {diameter * 1e3:.0f} mm colon does not fit around a bend of radius "
                             f"{centerline.min_radius * 100:.0f} cm (the wall would fold); use a smaller --diameter")
-    mesh = tube_mesh(centerline, diameter + wall_thickness, element_size)
+    else:
+        mesh = tube_mesh(centerline, diameter + wall_thickness, element_size)
     return ColonGeometry("", mesh.nodes, mesh.triangles, mesh.fixed & ~mesh.end_ring, mesh.mobile, mesh.end_ring,
                          entry_point=centerline.position(0.0), entry_axis=centerline.tangent(0.0),
                          centerline_length=centerline.length,
@@ -170,6 +183,31 @@ def straight_geometry(diameter, angle_deg, element_size, wall_thickness, exit_le
     return straight_colon(STRAIGHT_LENGTH, diameter, element_size, wall_thickness)
 
 
+def check_patient_tube(centerline, diameter, wall_thickness):
+    """Raise unless a colon of lumen ``diameter`` (m; the file's profile when it has one) and wall
+    ``wall_thickness`` (m) fits ``centerline``: the diameter the case states, every bend cleared by
+    the wall's outer surface, no two parts of the tube's mid-surface crossing."""
+    centerline.check_case_diameter(diameter)
+    lumen = centerline.diameter_at if centerline.diameter_profile is not None else (
+        lambda s: np.full(np.shape(s), float(diameter)))
+    centerline.check_bend(lambda s: 0.5 * lumen(s) + wall_thickness, "the colon wall's outer surface")
+    centerline.check_tube(lambda s: lumen(s) + wall_thickness)
+    return lumen
+
+
+def patient_geometry(diameter, angle_deg, element_size, wall_thickness, exit_length, flexure_angle_deg,
+                     centerline=None):
+    """A patient's centerline (:class:`colonsim.insertion.anatomy.patient_centerline.PatientCenterline`)
+    as it is: angle, flexure and exit do not apply; the lumen is the file's diameter profile when
+    it has one (``diameter`` must then be its median), else ``diameter``."""
+    lumen = check_patient_tube(centerline, diameter, wall_thickness)
+    geometry = _tube_geometry(centerline, lumen, element_size, wall_thickness)
+    if centerline.diameter_profile is not None:
+        d = centerline.diameter_profile[1]
+        geometry.lumen_diameters = (float(d.min()), float(np.median(d)), float(d.max()))
+    return geometry
+
+
 def _builder(model):
     module, _, function = model.builder.partition(":")
     try:
@@ -180,7 +218,7 @@ def _builder(model):
 
 
 def colon_geometry(segment, diameter, angle_deg, element_size, wall_thickness, exit_length=EXIT_LENGTH,
-                   flexure_angle_deg=FLEXURE_ANGLE_DEG) -> ColonGeometry:
+                   flexure_angle_deg=FLEXURE_ANGLE_DEG, centerline=None) -> ColonGeometry:
     """The geometry of the catalog's colon model ``segment`` (:data:`colonsim.catalog.COLON_MODELS`).
 
     Builds it with the model's builder, then applies the model's rules: the mobile piece a
@@ -198,12 +236,21 @@ def colon_geometry(segment, diameter, angle_deg, element_size, wall_thickness, e
         m, the fixed straight every model continues into after its last mobile piece (10 cm).
     flexure_angle_deg : float
         Turn of the splenic (RSF) or hepatic (THF) flexure, deg (90).
+    centerline : PatientCenterline or None
+        The user's centerline, for (and only for) a model that reads one (``reads_centerline``:
+        ``patient``), from :func:`colonsim.insertion.anatomy.patient_centerline.load_patient_centerline`.
     """
     model = colon_model(segment)
+    if model.reads_centerline != (centerline is not None):
+        raise ColonsimError(f"colon model {model.name!r} {'needs' if model.reads_centerline else 'takes no'} "
+                            "centerline file; " + ("give one (--centerline FILE)" if model.reads_centerline else
+                                                   "drop it, or use --segment patient (--centerline implies it)"))
     model.check_angle(angle_deg)
     if not (np.isfinite(exit_length) and 0.0 <= exit_length <= EXIT_LIMIT):
         raise ColonsimError(f"exit length {exit_length * 1e3:g} mm must lie in 0-{EXIT_LIMIT * 1e3:g} mm")
-    geometry = _builder(model)(diameter, angle_deg, element_size, wall_thickness, exit_length, flexure_angle_deg)
+    extra = {"centerline": centerline} if model.reads_centerline else {}
+    geometry = _builder(model)(diameter, angle_deg, element_size, wall_thickness, exit_length, flexure_angle_deg,
+                               **extra)
     geometry.name = model.name
     if model.straightens or model.end_rule == PAST_MOBILE_END:
         if geometry.tube is None:

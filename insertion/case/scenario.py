@@ -38,7 +38,9 @@ import numpy as np
 from colonsim.catalog import CONTINUOUS_PUSH, colon_model
 from colonsim.errors import ColonsimError
 from colonsim.provenance import code_version
-from colonsim.insertion.anatomy.colon_segments import colon_geometry
+from colonsim.insertion.anatomy.colon_segments import check_patient_tube, colon_geometry
+from colonsim.insertion.anatomy.centerline_file import load_centerline_points
+from colonsim.insertion.anatomy.patient_centerline import SMOOTHING_MM, load_patient_centerline
 from colonsim.insertion.engine.contact import RodShellContact
 from colonsim.insertion.anatomy.manoeuvre import PushProfile, continuous_push, straighten_relax_push
 from colonsim.insertion.engine.material import REFERENCE_MATERIAL_PATH
@@ -51,6 +53,9 @@ from colonsim.insertion.engine.constraints import FixedNodes, LineConstraint, Pr
 from colonsim.insertion.engine.solver import ExplicitSolver
 
 COLON_DENSITY = 1040.0  # kg/m^3
+# Fields added after sweep folders existed: left out of the key at their default, so the keys of
+# cases that do not use them stay what they were (existing sweep folders resume).
+LATER_FIELDS = ("centerline", "centerline_smoothing_mm", "material_parameters")
 
 
 @dataclass
@@ -60,7 +65,14 @@ class InsertionCase:
     Attributes
     ----------
     segment : str
-        A colon model of :data:`colonsim.catalog.COLON_MODELS` (rsj, rsf, thf, thf-fixed, straight).
+        A colon model of :data:`colonsim.catalog.COLON_MODELS` (rsj, rsf, thf, thf-fixed, straight,
+        patient).
+    centerline : str or None
+        A patient's centerline CSV (docs/model.md, "A patient's centerline"), for and only for
+        segment ``patient``. With a ``diameter_mm`` column the file's profile runs and
+        ``diameter_mm`` must state its median (to 0.1 mm).
+    centerline_smoothing_mm : float
+        RMS tolerance of the smoothed centerline (**assumption** 1 mm, about a CT voxel).
     scope : str
         ``utc``, ``pdc``, ``sdc`` or an outer diameter in mm.
     diameter_mm : float
@@ -97,6 +109,8 @@ class InsertionCase:
     """
 
     segment: str = "rsj"
+    centerline: str | None = None
+    centerline_smoothing_mm: float = SMOOTHING_MM
     scope: str = "sdc"
     diameter_mm: float = 36.0
     angle_deg: float = 0.0
@@ -119,7 +133,13 @@ class InsertionCase:
 
     def validate(self):
         """Raise :class:`ColonsimError` naming the first bad input and its fix."""
-        colon_model(self.segment)
+        model = colon_model(self.segment)
+        if model.reads_centerline and self.centerline is None:
+            raise ColonsimError(f"segment {self.segment!r} is a patient's centerline; give the file "
+                                "(--centerline FILE, or centerline = \"FILE\" in a sweep)")
+        if self.centerline is not None and not model.reads_centerline:
+            raise ColonsimError(f"a centerline file is given for segment {self.segment!r}, which has its own shape; "
+                                "use segment 'patient' (--centerline implies it) or drop the centerline")
         checks = [
             ("diameter_mm", self.diameter_mm, 10.0, 80.0, "colon inner diameter in mm (23 or 36 in the source)"),
             ("wall_thickness_mm", self.wall_thickness_mm, 0.2, 10.0, "wall thickness in mm (2 assumed)"),
@@ -144,18 +164,45 @@ class InsertionCase:
         if self.element_size_mm > self.diameter_mm / 3:
             raise ColonsimError(f"element size {self.element_size_mm} mm is too coarse for a {self.diameter_mm} mm colon; "
                                 "use at most a third of the diameter")
-        colonoscope(self.scope).check_fits(self.diameter_mm * 1e-3)
         if self.material_parameters is not None:
             case_material(self.material, self.material_parameters)
+        scope = colonoscope(self.scope)
+        if self.centerline is None:
+            scope.check_fits(self.diameter_mm * 1e-3)
+            return
+        centerline = self.patient_centerline()
+        check_patient_tube(centerline, self.diameter_mm * 1e-3, self.wall_thickness_mm * 1e-3)
+        if centerline.diameter_profile is None:
+            scope.check_fits(self.diameter_mm * 1e-3)
+        else:
+            s, d = centerline.diameter_profile
+            i = int(d.argmin())
+            if scope.diameter >= d[i]:
+                raise ColonsimError(f"scope {scope.name} ({scope.diameter * 1e3:.1f} mm) does not fit the narrowest "
+                                    f"lumen of {self.centerline}, {d[i] * 1e3:.1f} mm at {s[i] * 100:.1f} cm (line "
+                                    f"{centerline.source.lines[i]}); choose a thinner scope or check that diameter")
+
+    def patient_centerline(self):
+        """The smoothed centerline of ``centerline`` (cached per file state), or None."""
+        if self.centerline is None:
+            return None
+        return load_patient_centerline(self.centerline, self.centerline_smoothing_mm)
 
     def to_dict(self) -> dict:
         return asdict(self)
 
     def key(self) -> str:
-        """A short hash of the inputs (identifies a run in sweeps and output folders)."""
+        """A short hash of the inputs (identifies a run in sweeps and output folders).
+
+        A centerline enters as the digest of its content (points, labels, names, diameters), not
+        its path: a moved or re-saved file keeps its runs, an edited one gets new ones."""
         inputs = self.to_dict()
-        if inputs["material_parameters"] is None:  # keys of cases without drawn materials stay as they were
-            del inputs["material_parameters"]
+        defaults = InsertionCase()
+        for name in LATER_FIELDS:
+            if inputs[name] == getattr(defaults, name):
+                del inputs[name]
+        if self.centerline is not None:
+            inputs["centerline"] = "sha256:" + load_centerline_points(self.centerline).digest()
         return hashlib.sha256(json.dumps(inputs, sort_keys=True).encode()).hexdigest()[:12]
 
 
@@ -185,7 +232,8 @@ def build_insertion(case: InsertionCase) -> Insertion:
     case.validate()
     D = case.diameter_mm * 1e-3
     geometry = colon_geometry(case.segment, D, case.angle_deg, case.element_size_mm * 1e-3,
-                              case.wall_thickness_mm * 1e-3, case.exit_length_mm * 1e-3, case.flexure_angle_deg)
+                              case.wall_thickness_mm * 1e-3, case.exit_length_mm * 1e-3, case.flexure_angle_deg,
+                              centerline=case.patient_centerline())
     material = case_material(case.material, case.material_parameters)
     shell = Shell(geometry.nodes, geometry.triangles, case.wall_thickness_mm * 1e-3, material,
                   density=COLON_DENSITY, name="colon")
@@ -195,7 +243,7 @@ def build_insertion(case: InsertionCase) -> Insertion:
     axis = np.asarray(geometry.entry_axis, dtype=float)
     axis = axis / np.linalg.norm(axis)
     anatomy = colon_model(case.segment)
-    length = anatomy.scope_length
+    length = anatomy.scope_length_for(geometry.centerline_length, case.sheath_reserve_mm * 1e-3)
     total_depth = length - case.sheath_reserve_mm * 1e-3
     tip_end = geometry.end_depth
     if anatomy.must_reach_end and total_depth <= tip_end:

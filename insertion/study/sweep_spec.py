@@ -35,8 +35,9 @@ or, for a space-filling design crossed with a grid (2 x 20 runs)::
 
 - ``scope`` takes a named scope (:data:`colonsim.catalog.NAMED_SCOPES`) or a diameter in mm;
   ``scope_diameter_mm`` (numbers) is the same axis given as diameters. Give one of the two.
-- ``material`` takes a material JSON path (relative paths are read from the TOML file's folder);
-  ``""`` means the source's parameters.
+- ``material`` takes a material JSON path, ``centerline`` a patient's centerline CSV (relative
+  paths are read from the TOML file's folder); ``""`` means the source's parameters (material)
+  or none (centerline).
 - With both ``[[grid]]`` and ``[lhs]``, every grid case is crossed with every hypercube sample.
   A key may appear in only one of ``[fixed]``, the grid blocks and ``[lhs]``.
 - Values are rounded to 3 decimals in the hypercube so that tables stay readable; the seed makes
@@ -213,9 +214,10 @@ def _coerce(name, value, where, base: Path | None):
         if isinstance(value, bool) or not isinstance(value, (str, int, float)):
             raise ColonsimError(f"{where}: scope = {value!r}; give {', '.join(NAMED_SCOPES)} or a diameter in mm")
         return "scope", (f"{_number(name, value, where):g}" if isinstance(value, (int, float)) else value.strip().lower())
-    if name == "material":
+    if name in ("material", "centerline"):  # paths relative to the TOML file's folder
         if not isinstance(value, str):
-            raise ColonsimError(f"{where}: material = {value!r}; give the path of a material JSON or \"\" for the default")
+            what = "a material JSON or \"\" for the default" if name == "material" else "a centerline CSV"
+            raise ColonsimError(f"{where}: {name} = {value!r}; give the path of {what}")
         if not value:
             return name, None
         try:
@@ -224,7 +226,7 @@ def _coerce(name, value, where, base: Path | None):
                 path = base / path
             return name, str(path.resolve())
         except (OSError, ValueError, RuntimeError) as exc:  # a NUL byte, an unknown ~user, a symlink loop
-            raise ColonsimError(f"{where}: material = {value!r} is not a usable path ({exc})") from None
+            raise ColonsimError(f"{where}: {name} = {value!r} is not a usable path ({exc})") from None
     if isinstance(default, bool):
         if not isinstance(value, bool):
             raise ColonsimError(f"{where}: {name} = {value!r}; give true or false")
