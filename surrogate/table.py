@@ -31,6 +31,7 @@ TARGET_LABELS = {name: catalog.COLUMNS[name].label
 NOT_SETTINGS = {name for name, column in catalog.COLUMNS.items() if column.kind != catalog.SETTING} | {
     "quasi_static_without_imposed_sliding"}
 REQUIRED = ("status", "segment", "scope_diameter_mm")
+CENTERLINE = "centerline"  # a patient model's centerline file (colonsim.catalog.COLUMNS)
 
 
 def read_results(path) -> pd.DataFrame:
@@ -61,6 +62,7 @@ def check_results(frame: pd.DataFrame, name="results table") -> pd.DataFrame:
     unknown = sorted(set(frame["segment"]) - set(segments))
     if unknown:
         raise ColonsimError(f"{name} has unknown segment(s) {', '.join(unknown)}; expected {', '.join(segments)}")
+    frame["segment"] = anatomy_segments(frame, name)
     for column in (*INPUTS, *TARGET_LABELS):
         if column in frame.columns:
             frame[column] = numeric_column(frame, column, name)
@@ -71,6 +73,26 @@ def check_results(frame: pd.DataFrame, name="results table") -> pd.DataFrame:
     if not (frame["status"] == "ok").any():
         raise ColonsimError(f"{name} has no run with status 'ok'; nothing to fit")
     return frame
+
+
+def anatomy_segments(frame: pd.DataFrame, name="results table") -> pd.Series:
+    """The segment of each row as the surrogate models it: a colon model of the catalog, or, for a
+    model that reads a patient's centerline file, ``"<model>:<file stem>"``, one model per anatomy
+    (runs on two patients' colons are not samples of one function)."""
+    segment = frame["segment"]
+    if CENTERLINE not in frame.columns:
+        return segment
+    reads = segment.map(lambda s: catalog.COLON_MODELS[s].reads_centerline)
+    files = frame[CENTERLINE].fillna("").astype(str).str.strip()
+    if (reads & (files == "")).any():
+        raise ColonsimError(f"{name}: {_rows(frame, reads & (files == ''))} run a patient model without a "
+                            f"{CENTERLINE}; fill in the file or remove those rows")
+    stems = files.map(lambda f: Path(f.replace("\\", "/")).stem.lower())
+    clash = {stem for stem in set(stems[reads]) if files[reads & (stems == stem)].nunique() > 1}
+    if clash:
+        raise ColonsimError(f"{name}: runs on different centerline files named {', '.join(sorted(clash))}; give each "
+                            "patient's file its own name so the surrogate can tell the anatomies apart")
+    return segment.where(~reads, segment + ":" + stems)
 
 
 def _rows(frame: pd.DataFrame, mask) -> str:
