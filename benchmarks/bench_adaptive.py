@@ -1,0 +1,167 @@
+"""Adaptive sweep against Latin hypercubes: runs needed for a given surrogate error (RSJ, coarse mesh).
+
+Run: python benchmarks/bench_adaptive.py [--out DIR] [--budget 40] [--first 10] [--batch 2]
+     [--lhs 10,15,20,30,40] [--test 30] [--workers 2]
+
+Domain: RSJ, scope_diameter_mm 9-13.5, diameter_mm 20-40, friction 0-0.1, on a coarse wall mesh
+(element 6 mm, scope spacing 10 mm: 2-3 s per run instead of 5-17 s at 3 mm; a benchmark of the
+designs, not of the physics). Designs, each a sweep folder under --out (a rerun reuses every
+finished run):
+
+- ``adaptive``: ``colonsim sweep --adaptive``'s loop, a first hypercube of --first runs, then
+  batches of --batch chosen by greatest posterior variance, to --budget runs;
+- ``lhs_N``: an independent Latin hypercube of N runs for each N of --lhs;
+- ``test``: an independent hypercube of --test runs, used only to measure errors.
+
+Two errors of final_deformation_cm, per design and size: the surrogate's leave-one-out RMSE
+(closed form, what the adaptive sweep stops on) and the RMSE of its predictions at the held-out
+test runs. The LOO RMSE of an adaptive design is measured on runs chosen where the model was
+unsure, so it is pessimistic next to an LHS's; the held-out RMSE compares the designs on equal
+terms. For each LHS size N the script reports the runs the adaptive sweep needed to reach the
+same error (the first round at or below it) and the ratio to N (the issue's goal: at most 0.5).
+Writes bench_adaptive.json, bench_adaptive.csv and bench_adaptive.png into --out.
+"""
+
+import argparse
+import json
+import os
+import sys
+import time
+import warnings
+from pathlib import Path
+
+os.environ.setdefault("NUMBA_NUM_THREADS", "1")  # this process only waits, fits and writes files
+
+import numpy as np  # noqa: E402
+import pandas as pd  # noqa: E402
+
+from colonsim.errors import ColonsimWarning  # noqa: E402
+from colonsim.insertion.study.adaptive_sweep import AdaptiveSettings, fit_round, run_adaptive_sweep  # noqa: E402
+from colonsim.insertion.study.sweep import run_sweep  # noqa: E402
+from colonsim.insertion.study.sweep_spec import parse_sweep  # noqa: E402
+
+TARGET = "final_deformation_cm"
+INPUTS = ["scope_diameter_mm", "diameter_mm", "friction"]
+SPEC = """
+[sweep]
+name = "{name}"
+seed = {seed}
+description = "bench_adaptive: RSJ on a coarse mesh (element 6 mm, scope spacing 10 mm)"
+
+[fixed]
+segment = "rsj"
+element_size_mm = 6.0
+scope_spacing_mm = 10.0
+
+[lhs]
+samples = {samples}
+scope_diameter_mm = [9, 13.5]
+diameter_mm = [20, 40]
+friction = [0, 0.1]
+"""
+# Seeds of the designs: each its own hypercube (the adaptive sweep's first round is not one of the LHS).
+SEEDS = {"adaptive": 1, "test": 999}
+
+
+def spec(name, seed, samples):
+    return parse_sweep(SPEC.format(name=name, seed=seed, samples=samples), origin=f"bench_adaptive {name}")
+
+
+def errors(table, test):
+    """(LOO RMSE, held-out RMSE, runs) of the surrogate fitted on ``table``'s ok runs."""
+    model, cv = fit_round(table, TARGET, 0)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", ColonsimWarning)  # test runs outside the box of a small design
+        predicted = model.predict(test[INPUTS], "rsj", TARGET)
+    held_out = float(np.sqrt(np.mean((predicted - test[TARGET].to_numpy()) ** 2)))
+    return cv["rsj"]["rmse"], held_out, int((table["status"] == "ok").sum())
+
+
+def runs_to_reach(curve, level):
+    """Fewest runs of the adaptive curve [(runs, error)] at or below ``level`` (None: not within budget)."""
+    return next((n for n, e in curve if e <= level), None)
+
+
+def main(argv=None):
+    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    p.add_argument("--out", type=Path, default=Path("bench_adaptive_runs"))
+    p.add_argument("--budget", type=int, default=40)
+    p.add_argument("--first", type=int, default=10)
+    p.add_argument("--batch", type=int, default=2)
+    p.add_argument("--lhs", default="10,15,20,30,40")
+    p.add_argument("--test", type=int, default=30)
+    p.add_argument("--workers", type=int, default=2)
+    args = p.parse_args(argv)
+    sizes = [int(s) for s in args.lhs.split(",")]
+    t0 = time.perf_counter()
+    kw = dict(workers=args.workers, progress=sys.stderr.isatty(), log=lambda *a: None)
+
+    test = run_sweep(spec("test", SEEDS["test"], args.test).cases, args.out / "test", spec=spec("test", SEEDS["test"], args.test), **kw).table
+    test = test[test["status"] == "ok"]
+    print(f"test set: {len(test)} ok runs ({time.perf_counter() - t0:.0f} s so far)", flush=True)
+
+    lhs = {}
+    for n in sizes:
+        s = spec(f"lhs_{n}", 100 + n, n)
+        lhs[n] = errors(run_sweep(s.cases, args.out / f"lhs_{n}", spec=s, **kw).table, test)
+        print(f"LHS {n}: LOO {lhs[n][0]:.4f} cm, held-out {lhs[n][1]:.4f} cm ({time.perf_counter() - t0:.0f} s so far)",
+              flush=True)
+
+    s = spec("adaptive", SEEDS["adaptive"], args.first)
+    report = run_adaptive_sweep(s, args.out / "adaptive", AdaptiveSettings(args.budget, None, args.batch, TARGET),
+                                **kw)
+    table = report.table.set_index("key")
+    chosen, rows = [], []
+    for rnd in report.rounds:  # refit on the runs of the rounds so far: the surrogate the sweep had then
+        chosen += [r["key"] for r in rnd["chosen"]]
+        loo, held_out, ok = errors(table.loc[chosen].reset_index(), test)
+        rows.append({"design": "adaptive", "runs": len(chosen), "ok": ok, "loo_rmse_cm": loo, "held_out_rmse_cm": held_out})
+    rows += [{"design": "lhs", "runs": n, "ok": ok, "loo_rmse_cm": loo, "held_out_rmse_cm": ho} for n, (loo, ho, ok) in lhs.items()]
+    frame = pd.DataFrame(rows)
+
+    adaptive = frame[frame["design"] == "adaptive"]
+    comparison = []
+    for n, (loo, held_out, _) in lhs.items():
+        entry = {"lhs_runs": n}
+        for name, level in (("loo", loo), ("held_out", held_out)):
+            need = runs_to_reach(list(zip(adaptive["runs"], adaptive[f"{name}_rmse_cm"])), level)
+            entry.update({f"{name}_level_cm": level, f"{name}_adaptive_runs": need,
+                          f"{name}_ratio": None if need is None else need / n})
+        comparison.append(entry)
+    comparison = pd.DataFrame(comparison)
+
+    pd.set_option("display.width", 160)
+    print("\nerror by design and runs (final_deformation_cm, cm):")
+    print(frame.to_string(index=False, float_format=lambda v: f"{v:.4f}"))
+    print("\nadaptive runs needed to reach each LHS's error, and the ratio to the LHS's runs:")
+    print(comparison.to_string(index=False, float_format=lambda v: f"{v:.3f}"))
+    args.out.mkdir(parents=True, exist_ok=True)
+    frame.to_csv(args.out / "bench_adaptive.csv", index=False)
+    (args.out / "bench_adaptive.json").write_text(json.dumps({
+        "command": "python benchmarks/bench_adaptive.py " + " ".join(argv if argv is not None else sys.argv[1:]),
+        "errors": frame.to_dict("records"), "comparison": comparison.astype(object).where(comparison.notna(), None).to_dict("records"),
+        "stopped": report.stopped, "wall_time_s": time.perf_counter() - t0}, indent=1))
+    figure(frame).savefig(args.out / "bench_adaptive.png", dpi=120)
+    print(f"\nwrote {args.out}/bench_adaptive.json, .csv, .png ({time.perf_counter() - t0:.0f} s)")
+
+
+def figure(frame):
+    from matplotlib.figure import Figure
+
+    fig = Figure(figsize=(9, 3.8))
+    axes = fig.subplots(1, 2, sharey=True)
+    for ax, col, title in zip(axes, ("loo_rmse_cm", "held_out_rmse_cm"), ("leave-one-out RMSE", "held-out RMSE (test runs)")):
+        for design, style in (("adaptive", "o-"), ("lhs", "s--")):
+            rows = frame[frame["design"] == design]
+            ax.plot(rows["runs"], rows[col], style, label="adaptive (max variance)" if design == "adaptive" else "Latin hypercube")
+        ax.set_title(title, fontsize=10)
+        ax.set_xlabel("runs")
+        ax.grid(alpha=0.3)
+    axes[0].set_ylabel("RMSE of final deformation [cm]")
+    axes[0].legend()
+    fig.tight_layout()
+    return fig
+
+
+if __name__ == "__main__":
+    main()
