@@ -1,15 +1,16 @@
 """Adaptive sweep against Latin hypercubes: runs needed for a given surrogate error (RSJ, coarse mesh).
 
 Run: python benchmarks/bench_adaptive.py [--out DIR] [--budget 40] [--first 10] [--batch 2]
-     [--lhs 10,15,20,30,40] [--test 30] [--workers 2]
+     [--criteria variance,error] [--lhs 10,15,20,30,40] [--test 30] [--workers 2]
 
 Domain: RSJ, scope_diameter_mm 9-13.5, diameter_mm 20-40, friction 0-0.1, on a coarse wall mesh
 (element 6 mm, scope spacing 10 mm: 2-3 s per run instead of 5-17 s at 3 mm; a benchmark of the
 designs, not of the physics). Designs, each a sweep folder under --out (a rerun reuses every
 finished run):
 
-- ``adaptive``: ``colonsim sweep --adaptive``'s loop, a first hypercube of --first runs, then
-  batches of --batch chosen by greatest posterior variance, to --budget runs;
+- ``adaptive`` (criterion variance) and ``adaptive_error``: ``colonsim sweep --adaptive``'s loop,
+  a first hypercube of --first runs (the same for both), then batches of --batch chosen by each
+  criterion of --criteria, to --budget runs;
 - ``lhs_N``: an independent Latin hypercube of N runs for each N of --lhs;
 - ``test``: an independent hypercube of --test runs, used only to measure errors.
 
@@ -88,6 +89,7 @@ def main(argv=None):
     p.add_argument("--budget", type=int, default=40)
     p.add_argument("--first", type=int, default=10)
     p.add_argument("--batch", type=int, default=2)
+    p.add_argument("--criteria", default="variance,error")
     p.add_argument("--lhs", default="10,15,20,30,40")
     p.add_argument("--test", type=int, default=30)
     p.add_argument("--workers", type=int, default=2)
@@ -107,27 +109,32 @@ def main(argv=None):
         print(f"LHS {n}: LOO {lhs[n][0]:.4f} cm, held-out {lhs[n][1]:.4f} cm ({time.perf_counter() - t0:.0f} s so far)",
               flush=True)
 
-    s = spec("adaptive", SEEDS["adaptive"], args.first)
-    report = run_adaptive_sweep(s, args.out / "adaptive", AdaptiveSettings(args.budget, None, args.batch, TARGET),
-                                **kw)
-    table = report.table.set_index("key")
-    chosen, rows = [], []
-    for rnd in report.rounds:  # refit on the runs of the rounds so far: the surrogate the sweep had then
-        chosen += [r["key"] for r in rnd["chosen"]]
-        loo, held_out, ok = errors(table.loc[chosen].reset_index(), test)
-        rows.append({"design": "adaptive", "runs": len(chosen), "ok": ok, "loo_rmse_cm": loo, "held_out_rmse_cm": held_out})
+    rows, stopped = [], {}
+    for criterion in args.criteria.split(","):
+        s = spec("adaptive", SEEDS["adaptive"], args.first)
+        folder = args.out / ("adaptive" if criterion == "variance" else f"adaptive_{criterion}")
+        report = run_adaptive_sweep(s, folder, AdaptiveSettings(args.budget, None, args.batch, TARGET, criterion), **kw)
+        stopped[criterion] = report.stopped
+        table = report.table.set_index("key")
+        chosen = []
+        for rnd in report.rounds:  # refit on the runs of the rounds so far: the surrogate the sweep had then
+            chosen += [r["key"] for r in rnd["chosen"]]
+            loo, held_out, ok = errors(table.loc[chosen].reset_index(), test)
+            rows.append({"design": f"adaptive-{criterion}", "runs": len(chosen), "ok": ok, "loo_rmse_cm": loo,
+                         "held_out_rmse_cm": held_out})
+        print(f"adaptive ({criterion}): {len(chosen)} runs ({time.perf_counter() - t0:.0f} s so far)", flush=True)
     rows += [{"design": "lhs", "runs": n, "ok": ok, "loo_rmse_cm": loo, "held_out_rmse_cm": ho} for n, (loo, ho, ok) in lhs.items()]
     frame = pd.DataFrame(rows)
 
-    adaptive = frame[frame["design"] == "adaptive"]
     comparison = []
-    for n, (loo, held_out, _) in lhs.items():
-        entry = {"lhs_runs": n}
-        for name, level in (("loo", loo), ("held_out", held_out)):
-            need = runs_to_reach(list(zip(adaptive["runs"], adaptive[f"{name}_rmse_cm"])), level)
-            entry.update({f"{name}_level_cm": level, f"{name}_adaptive_runs": need,
-                          f"{name}_ratio": None if need is None else need / n})
-        comparison.append(entry)
+    for design, adaptive in frame[frame["design"] != "lhs"].groupby("design", sort=False):
+        for n, (loo, held_out, _) in lhs.items():
+            entry = {"design": design, "lhs_runs": n}
+            for name, level in (("loo", loo), ("held_out", held_out)):
+                need = runs_to_reach(list(zip(adaptive["runs"], adaptive[f"{name}_rmse_cm"])), level)
+                entry.update({f"{name}_level_cm": level, f"{name}_adaptive_runs": need,
+                              f"{name}_ratio": None if need is None else need / n})
+            comparison.append(entry)
     comparison = pd.DataFrame(comparison)
 
     pd.set_option("display.width", 160)
@@ -140,7 +147,7 @@ def main(argv=None):
     (args.out / "bench_adaptive.json").write_text(json.dumps({
         "command": "python benchmarks/bench_adaptive.py " + " ".join(argv if argv is not None else sys.argv[1:]),
         "errors": frame.to_dict("records"), "comparison": comparison.astype(object).where(comparison.notna(), None).to_dict("records"),
-        "stopped": report.stopped, "wall_time_s": time.perf_counter() - t0}, indent=1))
+        "stopped": stopped, "wall_time_s": time.perf_counter() - t0}, indent=1))
     figure(frame).savefig(args.out / "bench_adaptive.png", dpi=120)
     print(f"\nwrote {args.out}/bench_adaptive.json, .csv, .png ({time.perf_counter() - t0:.0f} s)")
 
@@ -151,9 +158,9 @@ def figure(frame):
     fig = Figure(figsize=(9, 3.8))
     axes = fig.subplots(1, 2, sharey=True)
     for ax, col, title in zip(axes, ("loo_rmse_cm", "held_out_rmse_cm"), ("leave-one-out RMSE", "held-out RMSE (test runs)")):
-        for design, style in (("adaptive", "o-"), ("lhs", "s--")):
-            rows = frame[frame["design"] == design]
-            ax.plot(rows["runs"], rows[col], style, label="adaptive (max variance)" if design == "adaptive" else "Latin hypercube")
+        for design, rows in frame.groupby("design", sort=False):
+            ax.plot(rows["runs"], rows[col], "s--" if design == "lhs" else "o-",
+                    label="Latin hypercubes" if design == "lhs" else design)
         ax.set_title(title, fontsize=10)
         ax.set_xlabel("runs")
         ax.grid(alpha=0.3)

@@ -43,6 +43,9 @@ def add_parser(sub):
     a.add_argument("--batch", type=positive_int, metavar="B",
                    help="runs chosen per round (default: the workers, or 4 on a Dask cluster)")
     a.add_argument("--target", metavar="COLUMN", help="output that chooses the runs (default final_deformation_cm)")
+    a.add_argument("--criterion", choices=("variance", "error"),
+                   help="where a round runs: greatest posterior variance (default) or greatest expected squared "
+                        "prediction error (the nearest run's leave-one-out error plus the variance)")
     p.set_defaults(func=cmd_sweep)
     return p
 
@@ -52,7 +55,7 @@ def _adaptive_settings(args, workers):
     from colonsim.insertion.study.adaptive_sweep import AdaptiveSettings
 
     given = [o for o, v in (("--budget", args.budget), ("--target-rmse", args.target_rmse), ("--batch", args.batch),
-                            ("--target", args.target)) if v is not None]
+                            ("--target", args.target), ("--criterion", args.criterion)) if v is not None]
     if not args.adaptive:
         if given:
             raise ColonsimError(f"{', '.join(given)} belong(s) to adaptive sweeps; add --adaptive or drop them")
@@ -63,7 +66,8 @@ def _adaptive_settings(args, workers):
     if args.budget is None:
         raise ColonsimError("--adaptive needs --budget N, the most runs in all (the first round included)")
     batch = args.batch or (4 if args.scheduler else workers)
-    return AdaptiveSettings(args.budget, args.target_rmse, batch, args.target or "final_deformation_cm")
+    return AdaptiveSettings(args.budget, args.target_rmse, batch, args.target or "final_deformation_cm",
+                            args.criterion or "variance")
 
 
 def _adaptive(args, spec, settings, out, workers, where):

@@ -5,7 +5,7 @@ The first round is the spec's own Latin hypercube (``[lhs] samples`` points per 
 later round draws a fresh, seeded Latin hypercube of :data:`POOL` points in the same ranges,
 rounded as the spec's hypercube is (:func:`colonsim.insertion.study.sweep_spec.lhs_values`),
 crosses it with every grid case, and leaves the choice among these candidates to the surrogate
-(:func:`colonsim.surrogate.acquisition.greedy_max_variance`).
+(:func:`colonsim.surrogate.acquisition.greedy_batch`).
 """
 
 from __future__ import annotations

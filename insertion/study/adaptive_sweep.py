@@ -3,8 +3,9 @@
 Round 0 is the spec's own Latin hypercube (``[lhs] samples`` points per ``[[grid]]`` case). After
 each round the surrogate (:class:`colonsim.surrogate.model.SweepSurrogate`, one GP per segment)
 is fitted on the sweep's successful runs, and the next batch is the candidates of greatest
-posterior variance (:func:`colonsim.surrogate.acquisition.greedy_max_variance`) among a fresh,
-seeded hypercube of the same ranges (:class:`colonsim.insertion.study.adaptive_design.AdaptiveDesign`).
+posterior variance, or of greatest expected squared prediction error
+(:func:`colonsim.surrogate.acquisition.greedy_batch`), among a fresh, seeded hypercube of the same
+ranges (:class:`colonsim.insertion.study.adaptive_design.AdaptiveDesign`).
 A segment whose leave-one-out RMSE has reached the target gets no more runs. The sweep stops when
 every segment has reached it, or at the budget (total runs, failed ones included).
 
@@ -37,12 +38,14 @@ from colonsim.insertion.case.run_budget import DEFAULT_MAX_STEPS
 from colonsim.insertion.case.scenario import InsertionCase
 from colonsim.insertion.study.adaptive_design import AdaptiveDesign, input_matrix
 from colonsim.insertion.study.sweep import run_sweep
-from colonsim.surrogate.acquisition import greedy_max_variance
+from colonsim.surrogate.acquisition import CRITERIA, greedy_batch
 from colonsim.surrogate.table import TARGET_LABELS
 
 ROUNDS = "adaptive_rounds.json"
 FIGURE = "adaptive_rmse.png"
-CRITERION = "greedy maximum posterior variance of the trend (GP conditioned on each pick)"
+WHY = {"variance": "greatest posterior variance of the trend (greedy, the GP conditioned on each pick)",
+       "error": "greatest expected squared prediction error: the nearest run's squared leave-one-out error plus "
+                "the trend's posterior variance (greedy, the GP conditioned on each pick)"}
 METRICS = ("n", "rmse", "max_abs_error", "coverage_95", "mean_std", "q2")
 
 
@@ -61,12 +64,15 @@ class AdaptiveSettings:
         Runs chosen per round (run in parallel).
     target : str
         The output column the surrogate is judged and the runs chosen by.
+    criterion : "variance" or "error"
+        How a round chooses (:func:`colonsim.surrogate.acquisition.greedy_batch`).
     """
 
     budget: int
     target_rmse: float | None = None
     batch: int = 4
     target: str = "final_deformation_cm"
+    criterion: str = "variance"
 
     def check(self, first_round: int):
         if self.target not in TARGET_LABELS:
@@ -75,6 +81,8 @@ class AdaptiveSettings:
         if self.target_rmse is not None and not self.target_rmse > 0:
             raise ColonsimError(f"--target-rmse {self.target_rmse:g} must be positive (the leave-one-out RMSE to reach, "
                                 "in the target's unit, e.g. 0.1 cm)")
+        if self.criterion not in CRITERIA:
+            raise ColonsimError(f"--criterion {self.criterion!r} is unknown; use one of {', '.join(CRITERIA)}")
         if self.batch < 1:
             raise ColonsimError(f"--batch {self.batch}; choose at least 1 run per round")
         if self.budget < first_round:
@@ -123,8 +131,7 @@ def read_rounds(folder, spec, settings) -> dict:
     """The round log of ``folder`` (a new one if there is none); refuses a log of another sweep or target."""
     path = Path(folder) / ROUNDS
     if not path.is_file():
-        return {"sweep": spec.name, "seed": spec.seed, "toml": spec.source, "target": settings.target,
-                "criterion": CRITERION, "rounds": []}
+        return {"sweep": spec.name, "seed": spec.seed, "toml": spec.source, "target": settings.target, "rounds": []}
     try:
         log = json.loads(path.read_text(encoding="utf-8"))
         rounds, toml, target = log["rounds"], log["toml"], log["target"]
@@ -144,6 +151,8 @@ def _pick_record(design, case, pick=None) -> dict:
     record = {"key": case.key(), "segment": case.segment, "inputs": design.inputs(case)}
     if pick is not None:
         record.update(predicted_sd=pick.sd, predicted_sd_with_scatter=pick.sd_with_scatter)
+        if pick.bias:
+            record["nearest_loo_error"] = pick.bias
     record["case"] = case.to_dict()
     return record
 
@@ -176,7 +185,7 @@ def _open_segments(cv, target_rmse) -> list:
     return [s for s, m in cv.items() if "rmse" in m and (target_rmse is None or m["rmse"] > target_rmse)]
 
 
-def choose_batch(design, model, target, segments, round_index, exclude, batch):
+def choose_batch(design, model, target, segments, round_index, exclude, batch, criterion="variance"):
     """The next ``batch`` cases among the round's candidates of ``segments``, with their picks."""
     by_segment = {}
     for case in design.candidates(round_index, exclude):
@@ -187,7 +196,7 @@ def choose_batch(design, model, target, segments, round_index, exclude, batch):
         domain, gp = model.model_for(segment, target)
         groups.append((gp, input_matrix(found, domain.inputs)))
         cases.append(found)
-    picks = greedy_max_variance(groups, batch) if groups else []
+    picks = greedy_batch(groups, batch, criterion) if groups else []
     return [(cases[p.group][p.index], p) for p in picks]
 
 
@@ -229,7 +238,7 @@ def run_adaptive_sweep(spec, out, settings: AdaptiveSettings, workers=2, schedul
             stopped = "budget reached"
         if not stopped:
             picks = choose_batch(design, model, settings.target, open_segments, current["round"] + 1, cases,
-                                 min(settings.batch, settings.budget - len(cases)))
+                                 min(settings.batch, settings.budget - len(cases)), settings.criterion)
             if not picks:
                 stopped = "no candidate left (every segment without a model, or the candidates all run)"
         if stopped:
@@ -237,7 +246,8 @@ def run_adaptive_sweep(spec, out, settings: AdaptiveSettings, workers=2, schedul
                                  "target_rmse": settings.target_rmse, "budget": settings.budget}
             write_json(out / ROUNDS, record)
             break
-        rounds.append({"round": current["round"] + 1, "why": CRITERION, "batch": settings.batch,
+        rounds.append({"round": current["round"] + 1, "why": WHY[settings.criterion], "criterion": settings.criterion,
+                       "batch": settings.batch,
                        "target_rmse": settings.target_rmse,
                        "chosen": [_pick_record(design, case, pick) for case, pick in picks]})
         record.pop("stopped", None)
@@ -269,7 +279,8 @@ def rounds_figure(record, target_rmse=None):
         ax.axhline(target_rmse, color="k", ls="--", lw=1, label=f"target {target_rmse:g}")
     ax.set_xlabel("runs")
     ax.set_ylabel(f"leave-one-out RMSE, {TARGET_LABELS.get(record['target'], record['target'])}")
-    ax.set_title(f"adaptive sweep {record['sweep']}: {record['criterion'].split(' (')[0]}", fontsize=9)
+    criteria = sorted({r["criterion"] for r in record["rounds"] if "criterion" in r})
+    ax.set_title(f"adaptive sweep {record['sweep']} (criterion: {', '.join(criteria) or 'none yet'})", fontsize=9)
     ax.grid(alpha=0.3)
     ax.legend()
     fig.tight_layout()
