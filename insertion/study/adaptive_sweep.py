@@ -33,7 +33,7 @@ from pathlib import Path
 import pandas as pd
 
 from colonsim.errors import ColonsimError
-from colonsim.files import check_output_folder, write_json
+from colonsim.files import check_output_folder, save_figure, write_json
 from colonsim.insertion.case.run_budget import DEFAULT_MAX_STEPS
 from colonsim.insertion.case.scenario import InsertionCase
 from colonsim.insertion.study.adaptive_design import AdaptiveDesign, input_matrix
@@ -229,6 +229,7 @@ def run_adaptive_sweep(spec, out, settings: AdaptiveSettings, workers=2, schedul
         except ColonsimError as exc:
             raise ColonsimError(f"adaptive sweep, round {current['round']}: {exc}") from None
         current.update(cv=cv, runs=len(cases), ok=int((sweep.table["status"] == "ok").sum()), finished_at=_now())
+        save_figure(rounds_figure(record, settings.target_rmse), out / FIGURE, dpi=120)
         open_segments = _open_segments(cv, settings.target_rmse)
         log(f"round {current['round']}: {len(current['chosen'])} run(s), {len(cases)} in all; LOO RMSE "
             + ", ".join(f"{s} {m['rmse']:.3g}" if "rmse" in m else f"{s} no model" for s, m in cv.items()))
@@ -253,7 +254,6 @@ def run_adaptive_sweep(spec, out, settings: AdaptiveSettings, workers=2, schedul
         record.pop("stopped", None)
         write_json(out / ROUNDS, record)  # the choice first: a sweep killed during the batch reruns the same batch
         cases.update((case.key(), case) for case, _ in picks)
-    rounds_figure(record, settings.target_rmse).savefig(out / FIGURE, dpi=120)
     return AdaptiveReport(out, rounds, stopped, len(cases), ran, sweep.table)
 
 
