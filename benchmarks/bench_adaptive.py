@@ -71,13 +71,17 @@ def spec(name, seed, samples):
 
 
 def errors(table, test, target):
-    """(LOO RMSE, held-out RMSE, runs) of the surrogate of ``target`` fitted on ``table``'s ok runs."""
+    """(LOO RMSE, held-out RMSE, runs, scatter sd, spread) of the surrogate of ``target`` fitted on
+    ``table``'s ok runs; the scatter sd is the GP's run-to-run noise, the floor of any held-out
+    RMSE, the spread the target's standard deviation over the runs."""
     model, cv = fit_round(table, target, 0)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", ColonsimWarning)  # test runs outside the box of a small design
         predicted = model.predict(test[INPUTS], "rsj", target)
     held_out = float(np.sqrt(np.mean((predicted - test[target].to_numpy()) ** 2)))
-    return cv["rsj"]["rmse"], held_out, int((table["status"] == "ok").sum())
+    ok = table["status"] == "ok"
+    return (cv["rsj"]["rmse"], held_out, int(ok.sum()), model.models_["rsj"][target].noise_std,
+            float(table.loc[ok, target].std()))
 
 
 def runs_to_reach(curve, level):
@@ -124,20 +128,21 @@ def main(argv=None):
         chosen = []
         for rnd in report.rounds:  # refit on the runs of the rounds so far: the surrogate the sweep had then
             chosen += [r["key"] for r in rnd["chosen"]]
-            loo, held_out, ok = errors(table.loc[chosen].reset_index(), test, target)
-            rows.append({"design": f"adaptive-{criterion}", "runs": len(chosen), "ok": ok, "loo_rmse_cm": loo,
-                         "held_out_rmse_cm": held_out})
+            loo, held_out, ok, scatter, spread = errors(table.loc[chosen].reset_index(), test, target)
+            rows.append({"design": f"adaptive-{criterion}", "runs": len(chosen), "ok": ok, "loo_rmse": loo,
+                         "held_out_rmse": held_out, "scatter_sd": scatter, "spread_sd": spread})
         print(f"adaptive ({criterion}): {len(chosen)} runs ({time.perf_counter() - t0:.0f} s so far)", flush=True)
-    rows += [{"design": "lhs", "runs": n, "ok": ok, "loo_rmse_cm": loo, "held_out_rmse_cm": ho} for n, (loo, ho, ok) in lhs.items()]
+    rows += [{"design": "lhs", "runs": n, "ok": ok, "loo_rmse": loo, "held_out_rmse": ho, "scatter_sd": sd,
+              "spread_sd": spread} for n, (loo, ho, ok, sd, spread) in lhs.items()]
     frame = pd.DataFrame(rows)
 
     comparison = []
     for design, adaptive in frame[frame["design"] != "lhs"].groupby("design", sort=False):
-        for n, (loo, held_out, _) in lhs.items():
+        for n, (loo, held_out, *_) in lhs.items():
             entry = {"design": design, "lhs_runs": n}
             for name, level in (("loo", loo), ("held_out", held_out)):
-                need = runs_to_reach(list(zip(adaptive["runs"], adaptive[f"{name}_rmse_cm"])), level)
-                entry.update({f"{name}_level_cm": level, f"{name}_adaptive_runs": need,
+                need = runs_to_reach(list(zip(adaptive["runs"], adaptive[f"{name}_rmse"])), level)
+                entry.update({f"{name}_level": level, f"{name}_adaptive_runs": need,
                               f"{name}_ratio": None if need is None else need / n})
             comparison.append(entry)
     comparison = pd.DataFrame(comparison)
@@ -163,7 +168,7 @@ def figure(frame, target):
 
     fig = Figure(figsize=(9, 3.8))
     axes = fig.subplots(1, 2, sharey=True)
-    for ax, col, title in zip(axes, ("loo_rmse_cm", "held_out_rmse_cm"), ("leave-one-out RMSE", "held-out RMSE (test runs)")):
+    for ax, col, title in zip(axes, ("loo_rmse", "held_out_rmse"), ("leave-one-out RMSE", "held-out RMSE (test runs)")):
         for design, rows in frame.groupby("design", sort=False):
             ax.plot(rows["runs"], rows[col], "s--" if design == "lhs" else "o-",
                     label="Latin hypercubes" if design == "lhs" else design)
