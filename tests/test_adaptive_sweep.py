@@ -250,6 +250,17 @@ def test_the_loop_stops_at_the_budget_resumes_without_repeating_and_records_roun
     chosen = [[p["key"] for p in r["chosen"]] for r in rounds_of(out)]
     assert [len(c) for c in chosen] == [4, 2, 2, 1] and chosen == expected_rounds(s, 9, 2)
 
+    # killed during the last batch: its choice is recorded, its run is not; the rerun runs just that
+    table = pd.read_parquet(out / "results.parquet")
+    table[table["key"] != chosen[-1][0]].to_parquet(out / "results.parquet", index=False)
+    log = json.loads((out / ROUNDS).read_text())
+    del log["rounds"][-1]["cv"], log["stopped"]
+    (out / ROUNDS).write_text(json.dumps(log))
+    killed = run_adaptive_sweep(s, out, AdaptiveSettings(budget=9, batch=2), workers=1, runner=standin_runner,
+                                progress=False, log=lambda *a: None)
+    assert (killed.ran, killed.runs, killed.stopped) == (1, 9, "budget reached")
+    assert [[p["key"] for p in r["chosen"]] for r in rounds_of(out)] == chosen and "cv" in rounds_of(out)[-1]
+
     # the folder refuses another sweep, adaptive or plain, and another target
     with pytest.raises(ColonsimError, match="another sweep"):
         run_adaptive_sweep(spec(samples=4, seed=4), out, AdaptiveSettings(budget=14), runner=standin_runner,
