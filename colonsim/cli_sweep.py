@@ -6,7 +6,7 @@ from pathlib import Path
 
 from colonsim.errors import ColonsimError
 from colonsim.files import check_output_folder
-from colonsim.options import output_folder, positive_int
+from colonsim.options import finite_float, output_folder, positive_int
 from colonsim.insertion.case.run_budget import DEFAULT_MAX_STEPS
 from colonsim.workflows import available_cores
 
@@ -33,12 +33,59 @@ def add_parser(sub):
                    help=f"refuse the sweep if a run needs more time steps (default {DEFAULT_MAX_STEPS:,}; one run "
                         "per material file is estimated: a material in the wrong unit makes every run long)")
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
+    a = p.add_argument_group("adaptive sweeps (docs/sweeps.md, 'Adaptive sweeps')")
+    a.add_argument("--adaptive", action="store_true",
+                   help="choose the runs: the [lhs] hypercube first, then batches where the surrogate is least certain")
+    a.add_argument("--budget", type=positive_int, metavar="N", help="most runs in all (with --adaptive; required)")
+    a.add_argument("--target-rmse", type=finite_float, metavar="X",
+                   help="stop when the leave-one-out RMSE of --target is at most X in every segment (its unit: cm "
+                        "for deformations); default: run to the budget")
+    a.add_argument("--batch", type=positive_int, metavar="B",
+                   help="runs chosen per round (default: the workers, or 4 on a Dask cluster)")
+    a.add_argument("--target", metavar="COLUMN", help="output that chooses the runs (default final_deformation_cm)")
+    a.add_argument("--criterion", choices=("variance", "error"),
+                   help="where a round runs: greatest posterior variance (default) or greatest expected squared "
+                        "prediction error (the nearest run's leave-one-out error plus the variance)")
     p.set_defaults(func=cmd_sweep)
     return p
 
 
+def _adaptive_settings(args, workers):
+    """The adaptive settings of the command line, or None for a plain sweep; one-line errors."""
+    from colonsim.insertion.study.adaptive_sweep import AdaptiveSettings
+
+    given = [o for o, v in (("--budget", args.budget), ("--target-rmse", args.target_rmse), ("--batch", args.batch),
+                            ("--target", args.target), ("--criterion", args.criterion)) if v is not None]
+    if not args.adaptive:
+        if given:
+            raise ColonsimError(f"{', '.join(given)} belong(s) to adaptive sweeps; add --adaptive or drop them")
+        return None
+    if args.dry_run:
+        raise ColonsimError("--dry-run cannot list an adaptive sweep's runs (they are chosen as results come in); "
+                            "drop --adaptive to list the first round")
+    if args.budget is None:
+        raise ColonsimError("--adaptive needs --budget N, the most runs in all (the first round included)")
+    batch = args.batch or (4 if args.scheduler else workers)
+    return AdaptiveSettings(args.budget, args.target_rmse, batch, args.target or "final_deformation_cm",
+                            args.criterion or "variance")
+
+
+def _adaptive(args, spec, settings, out, workers, where):
+    from colonsim.insertion.study.adaptive_sweep import FIGURE, ROUNDS, run_adaptive_sweep
+
+    goal = f"LOO RMSE of {settings.target} <= {settings.target_rmse:g} in every segment" if settings.target_rmse else ""
+    print(f"adaptive sweep {spec.name}: at most {settings.budget} runs{', until ' + goal if goal else ''}, "
+          f"{settings.batch} per round, on {where} -> {out}/", flush=True)
+    report = run_adaptive_sweep(spec, out, settings, workers=workers, scheduler=args.scheduler,
+                                retry_failed=args.retry_failed, progress=not args.no_progress,
+                                max_steps=args.max_steps)
+    print(f"stopped: {report.stopped} after {len(report.rounds)} round(s), {report.runs} runs ({report.ran} run now)")
+    print(f"results: {out / 'results.parquet'}; rounds: {out / ROUNDS}; figure: {out / FIGURE}")
+
+
 def cmd_sweep(args):
     from colonsim.insertion.case.run_budget import check_sweep_budget
+    from colonsim.insertion.study.adaptive_sweep import ROUNDS
     from colonsim.insertion.study.sweep import SweepStore, dask_distributed, describe_cases, run_sweep
     from colonsim.insertion.study.sweep_spec import load_sweep
 
@@ -47,9 +94,15 @@ def cmd_sweep(args):
     if args.scheduler is not None and not args.dry_run:
         dask_distributed()  # a missing dask fails before the sweep is announced or anything written
     workers = available_cores() if args.workers is None else args.workers
+    settings = _adaptive_settings(args, workers)
     spec = load_sweep(args.spec, args.preset)
     out = args.out or check_output_folder(Path("colonsim_results") / f"sweep_{spec.name}")
     where = f"Dask cluster {args.scheduler}" if args.scheduler else f"{workers} local process{'es' if workers > 1 else ''}"
+    if settings is not None:
+        return _adaptive(args, spec, settings, out, workers, where)
+    if (out / ROUNDS).is_file():
+        raise ColonsimError(f"{out} holds an adaptive sweep; continue it with --adaptive --budget N, or give this "
+                            "sweep another --out")
     if args.dry_run:
         check_sweep_budget(spec.cases, args.max_steps)
         store = SweepStore(out)

@@ -186,6 +186,7 @@ class SweepSpec:
     description: str
     cases: list = field(default_factory=list)
     source: str = ""
+    lhs_ranges: list = field(default_factory=list)  # [(key, low, high)] of [lhs], in its order (adaptive sweeps)
 
     def document(self) -> dict:
         """A JSON-able description (written next to the results)."""
@@ -291,7 +292,8 @@ def latin_hypercube(n: int, d: int, seed: int) -> np.ndarray:
     return qmc.LatinHypercube(d=d, seed=seed).random(n)
 
 
-def _lhs_cases(table, seed, base):
+def _lhs_ranges(table):
+    """``[lhs]`` as (samples, [(key, low, high)]), checked."""
     table = dict(table)
     samples = table.pop("samples", None)
     if isinstance(samples, bool) or not isinstance(samples, int) or samples < 1:
@@ -310,11 +312,16 @@ def _lhs_cases(table, seed, base):
         if key != SCOPE_DIAMETER and not isinstance(case_fields()[key].default, float):
             raise ColonsimError(f"[lhs] {key} is not a continuous input; put it in a [[grid]] block instead")
         ranges.append((key, low, high))
-    unit = latin_hypercube(samples, len(ranges), seed)
+    return samples, ranges
+
+
+def lhs_values(ranges, unit) -> list:
+    """Case values (field -> value) of the points ``unit`` (n, d) in [0, 1)^d mapped onto ``ranges``
+    (from :attr:`SweepSpec.lhs_ranges`), rounded to :data:`LHS_DECIMALS` as every hypercube is."""
     cases = []
-    for row in unit:
+    for row in np.atleast_2d(unit):
         values = (round(lo + u * (hi - lo), LHS_DECIMALS) for (_, lo, hi), u in zip(ranges, row))
-        cases.append(dict(_coerce(key, v, "[lhs]", base) for (key, _, _), v in zip(ranges, values)))
+        cases.append(dict(_coerce(key, v, "[lhs]", None) for (key, _, _), v in zip(ranges, values)))
     return cases
 
 
@@ -376,7 +383,8 @@ def parse_sweep(text: str, base: Path | None = None, origin: str = "sweep") -> S
     for block, where in zip(blocks, wheres):
         grid_cases += _grid_cases(block, where, base)
         grid_keys |= {("scope" if k == SCOPE_DIAMETER else k) for k in block}
-    lhs_cases = _lhs_cases(lhs, seed, base) if lhs is not None else []
+    samples, lhs_ranges = _lhs_ranges(lhs) if lhs is not None else (0, [])
+    lhs_cases = lhs_values(lhs_ranges, latin_hypercube(samples, len(lhs_ranges), seed)) if lhs is not None else []
     lhs_keys = {("scope" if k == SCOPE_DIAMETER else k) for k in (lhs or {}) if k != "samples"}
     fixed_keys = set(fixed)
     for a, b, ka, kb in (("fixed", "grid", fixed_keys, grid_keys), ("fixed", "lhs", fixed_keys, lhs_keys),
@@ -402,7 +410,7 @@ def parse_sweep(text: str, base: Path | None = None, origin: str = "sweep") -> S
     cases = sample_materials(doc, cases, base, seed, MAX_RUNS)
     _check_materials(cases)
     return SweepSpec(name=name.strip(), seed=seed, description=str(head.get("description", "")), cases=cases,
-                     source=text)
+                     source=text, lhs_ranges=lhs_ranges)
 
 
 def _check_size(origin, grid_sizes, lhs):
