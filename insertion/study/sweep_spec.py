@@ -40,16 +40,13 @@ or, for a space-filling design crossed with a grid (2 x 20 runs)::
   or none (centerline).
 - With both ``[[grid]]`` and ``[lhs]``, every grid case is crossed with every hypercube sample.
   A key may appear in only one of ``[fixed]``, the grid blocks and ``[lhs]``.
-- Values are rounded to 3 decimals in the hypercube so that tables stay readable; the seed makes
-  the sample (and so every run's key) reproducible.
-- Cases that come out identical (same :meth:`InsertionCase.key`) run once.
-- A ``[material]`` section crosses every case with wall materials drawn from a calibration
-  (:mod:`colonsim.insertion.study.material_samples`).
+- Hypercube values are rounded to 3 decimals (readable tables); the seed makes the sample, and so
+  every key, reproducible. Identical cases (same :meth:`InsertionCase.key`) run once.
+- ``[material]`` crosses every case with materials drawn from a calibration (:mod:`.material_samples`).
 
-Every case is validated before anything runs; errors are one line naming the key and the fix.
-Numbers must be finite (TOML allows ``inf`` and ``nan``), a sweep must vary something (``[fixed]``
-alone is one run: use ``colonsim insert``), and a sweep holds at most :data:`MAX_RUNS` runs,
-counted before any case is generated.
+Every case is validated before anything runs (one-line errors naming the key and the fix): finite
+numbers, something that varies (``[fixed]`` alone is ``colonsim insert``), at most :data:`MAX_RUNS`
+runs, counted before any case is generated.
 """
 
 from __future__ import annotations
