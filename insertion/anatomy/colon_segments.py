@@ -183,25 +183,32 @@ def straight_geometry(diameter, angle_deg, element_size, wall_thickness, exit_le
     return straight_colon(STRAIGHT_LENGTH, diameter, element_size, wall_thickness)
 
 
+def _patient_lumen(centerline, diameter):
+    """The lumen diameter ``D(s)`` (m) of a case on ``centerline``: the file's profile when it has
+    one (``diameter``, m, must then be its median), else ``diameter`` everywhere."""
+    centerline.check_case_diameter(diameter)
+    if centerline.diameter_profile is not None:
+        return centerline.diameter_at
+    return lambda s: np.full(np.shape(s), float(diameter))
+
+
 def check_patient_tube(centerline, diameter, wall_thickness):
     """Raise unless a colon of lumen ``diameter`` (m; the file's profile when it has one) and wall
     ``wall_thickness`` (m) fits ``centerline``: the diameter the case states, every bend cleared by
-    the wall's outer surface, no two parts of the tube's mid-surface crossing."""
-    centerline.check_case_diameter(diameter)
-    lumen = centerline.diameter_at if centerline.diameter_profile is not None else (
-        lambda s: np.full(np.shape(s), float(diameter)))
+    the wall's outer surface, no two parts of the tube's mid-surface crossing (the checks
+    :func:`patient_geometry` makes while meshing, without the mesh)."""
+    lumen = _patient_lumen(centerline, diameter)
     centerline.check_bend(lambda s: 0.5 * lumen(s) + wall_thickness, "the colon wall's outer surface")
     centerline.check_tube(lambda s: lumen(s) + wall_thickness)
-    return lumen
 
 
 def patient_geometry(diameter, angle_deg, element_size, wall_thickness, exit_length, flexure_angle_deg,
                      centerline=None):
     """A patient's centerline (:class:`colonsim.insertion.anatomy.patient_centerline.PatientCenterline`)
     as it is: angle, flexure and exit do not apply; the lumen is the file's diameter profile when
-    it has one (``diameter`` must then be its median), else ``diameter``."""
-    lumen = check_patient_tube(centerline, diameter, wall_thickness)
-    geometry = _tube_geometry(centerline, lumen, element_size, wall_thickness)
+    it has one (``diameter`` must then be its median), else ``diameter``. The wall's bend and
+    self-clearance checks are those of meshing (:func:`_tube_geometry`, :func:`tube_mesh`)."""
+    geometry = _tube_geometry(centerline, _patient_lumen(centerline, diameter), element_size, wall_thickness)
     if centerline.diameter_profile is not None:
         d = centerline.diameter_profile[1]
         geometry.lumen_diameters = (float(d.min()), float(np.median(d)), float(d.max()))

@@ -31,7 +31,7 @@ from scipy.interpolate import CubicSpline, make_smoothing_spline
 
 from colonsim.errors import ColonsimError
 from colonsim.insertion.anatomy.centerline import MAX_LENGTH, LabelledCenterline
-from colonsim.insertion.anatomy.centerline_file import load_centerline_points, read_centerline_points
+from colonsim.insertion.anatomy.centerline_file import load_centerline_points
 
 SMOOTHING_MM = 1.0  # assumption: RMS distance of the smoothed centerline from the points, ~ a CT voxel
 SMOOTHING_RANGE_MM = (0.0, 20.0)  # beyond 2 cm the "centerline" would no longer follow the colon
@@ -239,14 +239,15 @@ class PatientCenterline(LabelledCenterline):
     def check_bend(self, radius_at, what):
         """Raise where the bend radius is at most ``radius_at(s)`` (m): the tube ``what`` cannot follow it."""
         s = self._s_tab
-        bad = self.curvature_radius(s) <= radius_at(s)
+        radius, limit = self.curvature_radius(s), radius_at(s)
+        bad = radius <= limit
         if bad.any():
             i = int(np.argmax(bad))
-            worst = int(np.argmin(self.curvature_radius(s) - radius_at(s)))
+            worst = int(np.argmin(radius - limit))
             raise ColonsimError(
-                f"{self.source.path}: the centerline bends with radius {self.curvature_radius(s[worst]) * 1e3:.1f} mm "
+                f"{self.source.path}: the centerline bends with radius {radius[worst] * 1e3:.1f} mm "
                 f"at {s[worst] * 100:.1f} cm (near line {self.line_at(s[worst])}; tight from {s[i] * 100:.1f} cm), "
-                f"tighter than {what} of radius {radius_at(s[worst:worst + 1])[0] * 1e3:.1f} mm can follow; check the "
+                f"tighter than {what} of radius {limit[worst] * 1e3:.1f} mm can follow; check the "
                 "points there, raise the smoothing tolerance (centerline_smoothing_mm) or use a smaller diameter")
 
     def check_tube(self, diameter):
@@ -269,12 +270,13 @@ class PatientCenterline(LabelledCenterline):
 
 @lru_cache(maxsize=32)
 def _smoothed(path: str, mtime_ns: int, size: int, smoothing_mm: float) -> PatientCenterline:
-    return PatientCenterline(read_centerline_points(path), smoothing_mm)
+    return PatientCenterline(load_centerline_points(path), smoothing_mm)
 
 
 def load_patient_centerline(path, smoothing_mm=SMOOTHING_MM) -> PatientCenterline:
     """Read ``path`` and smooth it, cached per file state (path, modification time, size) and
-    tolerance: a case is validated, estimated and built from one reading."""
+    tolerance: a case is validated, estimated and built from one reading (the points come from
+    :func:`colonsim.insertion.anatomy.centerline_file.load_centerline_points`'s cache)."""
     load_centerline_points(path)  # its one-line errors for a missing or unreadable file
     path = Path(path).expanduser()
     stat = path.stat()
