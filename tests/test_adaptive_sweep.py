@@ -22,7 +22,7 @@ from colonsim.errors import ColonsimError, ColonsimWarning
 from colonsim.insertion.study.adaptive_design import AdaptiveDesign
 from colonsim.insertion.study.adaptive_sweep import (FIGURE, ROUNDS, AdaptiveSettings, choose_batch, fit_round,
                                                      run_adaptive_sweep)
-from colonsim.insertion.study.sweep import _inputs, result_row, run_sweep
+from colonsim.insertion.study.sweep import input_row, result_row, run_sweep
 from colonsim.insertion.study.sweep_spec import parse_sweep
 from colonsim.surrogate.acquisition import greedy_batch, trend_sd
 from colonsim.surrogate.gp import GaussianProcess
@@ -69,7 +69,7 @@ class StandIn:
 
 
 def summary_of(case):
-    row = _inputs(case)
+    row = input_row(case)
     value = float(bump(row["scope_diameter_mm"], row["diameter_mm"], row["friction"], case.segment))
     return {"final_deformation_cm": value, "max_deformation_cm": value, "scope": {"name": case.scope},
             "points_cm": {}}

@@ -15,7 +15,7 @@ import dataclasses
 import numpy as np
 
 from colonsim.errors import ColonsimError
-from colonsim.insertion.study.sweep import _inputs
+from colonsim.insertion.study.sweep import input_row
 from colonsim.insertion.study.sweep_spec import SCOPE_DIAMETER, latin_hypercube, lhs_values
 from colonsim.surrogate.table import INPUTS
 
@@ -83,13 +83,13 @@ class AdaptiveDesign:
 
     def inputs(self, case) -> dict:
         """The ``[lhs]`` values of ``case`` in the spec's keys and units (for the round log)."""
-        row = _inputs(case)
+        row = input_row(case)
         return {key: float(row[key]) for key, _, _ in self.ranges}
 
 
 def input_matrix(cases, names) -> np.ndarray:
     """The surrogate inputs ``names`` (results-table columns) of ``cases``, (n, d)."""
-    rows = [_inputs(case) for case in cases]
+    rows = [input_row(case) for case in cases]
     return np.array([[float(row[name]) for name in names] for row in rows], dtype=float).reshape(len(rows), len(names))
 
 

@@ -13,10 +13,9 @@ that were in flight; failed runs are recorded with their error (rerun them with
 ``retry_failed=True``) and never stop the others. A folder holds one sweep: another sweep (other
 cases) written into it is refused, so that one table never mixes two sweeps.
 
-Runs go to a local process pool (:func:`local_outcomes`) or to an existing Dask distributed
-cluster (:func:`dask_outcomes`); both yield outcomes as runs finish, and only this process
-writes files, so Dask workers need the package but no shared file system (material files
-named in the cases must exist on the workers, though).
+Runs go to a local process pool (:func:`local_outcomes`) or an existing Dask distributed cluster
+(:func:`dask_outcomes`); both yield outcomes as runs finish, and only this process writes files:
+Dask workers need the package, and the material and centerline files the cases name at their paths.
 """
 
 from __future__ import annotations
@@ -58,7 +57,8 @@ def input_columns() -> list:
     return [f.name for f in dataclasses.fields(InsertionCase)] + ["scope_diameter_mm", catalog.WALL_MU0, catalog.WALL_C11]
 
 
-def _inputs(case) -> dict:
+def input_row(case) -> dict:
+    """The input columns of ``case``'s results row (:func:`input_columns`)."""
     row = {}
     for f in dataclasses.fields(InsertionCase):
         value = getattr(case, f.name)
@@ -98,7 +98,7 @@ def result_row(case, outcome, timeseries_path="") -> dict:
     return {"key": case.key(), "status": outcome["status"], "error": outcome.get("error", ""),
             "wall_time_s": float(outcome["wall_time_s"]), "timeseries_path": timeseries_path if ok else "",
             "finished_at": outcome["finished_at"], "git_commit": code_version()["git_commit"] or "",
-            **_inputs(case), **_outputs(outcome.get("summary") if ok else None)}
+            **input_row(case), **_outputs(outcome.get("summary") if ok else None)}
 
 
 class SweepStore:
@@ -447,4 +447,4 @@ def describe_cases(cases) -> str:
 
 
 __all__ = ["SweepStore", "SweepReport", "run_sweep", "local_outcomes", "dask_outcomes", "read_results",
-           "result_row", "describe_cases", "IDENTITY", "OUTPUTS", "TABLE"]
+           "result_row", "input_row", "describe_cases", "IDENTITY", "OUTPUTS", "TABLE"]
