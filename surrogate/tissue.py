@@ -29,7 +29,8 @@ import pandas as pd
 from colonsim.catalog import WALL_C11, WALL_MU0
 from colonsim.errors import ColonsimError
 from colonsim.surrogate.domain import OutOfDomainWarning
-from colonsim.insertion.study.material_samples import (MATERIAL_PARAMETERS, Posterior, read_document, read_population,
+from colonsim.insertion.engine.material import read_material_document
+from colonsim.insertion.study.material_samples import (MATERIAL_PARAMETERS, Posterior, read_population,
                                                        read_posterior, tissue_columns)
 
 TISSUE_INPUTS = (WALL_MU0, WALL_C11)
@@ -58,7 +59,7 @@ class TissueDistribution:
     def from_file(cls, path):
         """A calibration's ``material.json`` (its posterior) or a ``population.json`` (its specimens)."""
         path = Path(path)
-        if "specimens" in read_document(path):
+        if "specimens" in read_material_document(path):
             pop = read_population(path)
             return cls("empirical", str(path), f"the {len(pop.values)} specimens of {path.name} ({pop.law})",
                        points=tissue_columns(pop.law, pop.values))

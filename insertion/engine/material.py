@@ -86,6 +86,29 @@ class WallMaterial:
         return self.law_model.uniaxial_nominal_stress(stretch, self.parameters)
 
 
+def read_material_document(path) -> dict:
+    """The JSON object of a material file (``colonsim calibrate`` output: material.json, or
+    population.json), unchecked beyond being one; one-line errors for a missing or broken file."""
+    path = Path(path)
+    if not path.is_file():
+        raise ColonsimError(
+            f"material file {path} not found; pass the JSON written by the calibration "
+            f"(reference copy: {REFERENCE_MATERIAL_PATH})."
+        )
+    try:
+        data = json.loads(path.read_text(encoding="utf-8"))
+    except (json.JSONDecodeError, UnicodeDecodeError) as exc:
+        raise ColonsimError(
+            f"material file {path} is not valid JSON ({exc}); fix or regenerate the file."
+        ) from None
+    if not isinstance(data, dict):
+        raise ColonsimError(
+            f"material file {path} must hold a JSON object with 'law' and 'parameters'; "
+            "fix or regenerate the file."
+        )
+    return data
+
+
 def load_material(path):
     """Read a material file of any law of :data:`colonsim.laws.LAWS`.
 
@@ -105,22 +128,7 @@ def load_material(path):
         Missing file, invalid JSON, unknown law or units, missing or invalid parameters.
     """
     path = Path(path)
-    if not path.is_file():
-        raise ColonsimError(
-            f"material file {path} not found; pass the JSON written by the calibration "
-            f"(reference copy: {REFERENCE_MATERIAL_PATH})."
-        )
-    try:
-        data = json.loads(path.read_text(encoding="utf-8"))
-    except (json.JSONDecodeError, UnicodeDecodeError) as exc:
-        raise ColonsimError(
-            f"material file {path} is not valid JSON ({exc}); fix or regenerate the file."
-        ) from None
-    if not isinstance(data, dict):
-        raise ColonsimError(
-            f"material file {path} must hold a JSON object with 'law' and 'parameters'; "
-            "fix or regenerate the file."
-        )
+    data = read_material_document(path)
     law = data.get("law")
     if not isinstance(law, str) or law not in LAWS:
         raise ColonsimError(

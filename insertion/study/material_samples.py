@@ -46,6 +46,7 @@ from colonsim.catalog import WALL_C11, WALL_MU0
 from colonsim.errors import ColonsimError
 from colonsim.laws import get_law
 from colonsim.insertion.case.case_material import case_material
+from colonsim.insertion.engine.material import read_material_document
 
 SECTION_KEYS = ("file", "population", "samples", "seed")
 MATERIAL_PARAMETERS = "material_parameters"  # the InsertionCase field a draw sets
@@ -92,25 +93,10 @@ class Population:
     path: str
 
 
-def read_document(path) -> dict:
-    """The JSON object of a calibration file; one-line errors for a missing or broken file."""
-    path = Path(path)
-    if not path.is_file():
-        raise ColonsimError(f"material file {path} not found; give the material.json or population.json that "
-                            "colonsim calibrate wrote")
-    try:
-        doc = json.loads(path.read_text(encoding="utf-8"))
-    except (json.JSONDecodeError, UnicodeDecodeError) as exc:
-        raise ColonsimError(f"material file {path} is not valid JSON ({exc}); fix or regenerate it") from None
-    if not isinstance(doc, dict):
-        raise ColonsimError(f"material file {path} must hold a JSON object; give a file colonsim calibrate wrote")
-    return doc
-
-
 def read_posterior(path) -> Posterior:
     """The posterior of a ``material.json``: its parameters and ``covariance_Pa2`` (law order)."""
     material = case_material(str(path))  # law, units and parameters checked as for a run
-    doc = read_document(path)
+    doc = read_material_document(path)
     names = material.law_model.parameter_names
     cov = doc.get("covariance_Pa2")
     if cov is None:
@@ -137,7 +123,7 @@ def read_posterior(path) -> Posterior:
 def read_population(path) -> Population:
     """The specimens of a ``population.json`` (``colonsim calibrate --per-specimen``)."""
     material = case_material(str(path))
-    doc = read_document(path)
+    doc = read_material_document(path)
     names = material.law_model.parameter_names
     rows = doc.get("specimens")
     if not isinstance(rows, list) or not rows:
