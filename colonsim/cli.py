@@ -135,9 +135,9 @@ def cmd_insert(args):
             raise ColonsimError(f"--threads {args.threads} must lie in 1-{numba.config.NUMBA_NUM_THREADS} (the cores Numba sees)")
         numba.set_num_threads(args.threads)
 
-    from colonsim.workflows import patient_inputs
+    from colonsim.workflows import anatomy_inputs
 
-    anatomy = patient_inputs(args.segment, args.centerline, args.diameter, args.centerline_smoothing)
+    anatomy = anatomy_inputs(args.segment, args.centerline, args.diameter, args.centerline_smoothing)
     cases = [InsertionCase(**anatomy, scope=scope, angle_deg=args.angle,
                            flexure_angle_deg=args.flexure_angle, friction=args.friction,
                            wall_thickness_mm=args.wall_thickness,

@@ -254,7 +254,7 @@ def _compare_laws(curve, options, per_eval, show, out: Path) -> list:
     return [comparison.chosen_result]
 
 
-def patient_inputs(segment, centerline, diameter_mm, smoothing_mm) -> dict:
+def anatomy_inputs(segment, centerline, diameter_mm, smoothing_mm) -> dict:
     """The anatomy fields of an :class:`InsertionCase` from the insert options (None: not given).
 
     ``centerline`` implies segment ``patient``; its diameter is, unless given, the median of the
