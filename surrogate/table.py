@@ -75,10 +75,19 @@ def check_results(frame: pd.DataFrame, name="results table") -> pd.DataFrame:
     return frame
 
 
+def model_segment(segment, centerline=None) -> str:
+    """The segment the surrogate models a run under: its colon model, or for a model that reads a
+    patient's centerline file ``"<model>:<file stem>"``, one model per anatomy (runs on two
+    patients' colons are not samples of one function)."""
+    model = catalog.COLON_MODELS.get(segment)
+    if model is None or not model.reads_centerline or not centerline:
+        return segment
+    return f"{segment}:{Path(str(centerline).replace(chr(92), '/')).stem.lower()}"
+
+
 def anatomy_segments(frame: pd.DataFrame, name="results table") -> pd.Series:
-    """The segment of each row as the surrogate models it: a colon model of the catalog, or, for a
-    model that reads a patient's centerline file, ``"<model>:<file stem>"``, one model per anatomy
-    (runs on two patients' colons are not samples of one function)."""
+    """:func:`model_segment` of every row; refuses a patient run without its file and two
+    different files of one name."""
     segment = frame["segment"]
     if CENTERLINE not in frame.columns:
         return segment
@@ -87,12 +96,13 @@ def anatomy_segments(frame: pd.DataFrame, name="results table") -> pd.Series:
     if (reads & (files == "")).any():
         raise ColonsimError(f"{name}: {_rows(frame, reads & (files == ''))} run a patient model without a "
                             f"{CENTERLINE}; fill in the file or remove those rows")
-    stems = files.map(lambda f: Path(f.replace("\\", "/")).stem.lower())
-    clash = {stem for stem in set(stems[reads]) if files[reads & (stems == stem)].nunique() > 1}
+    modelled = pd.Series([model_segment(s, f) for s, f in zip(segment, files)], index=frame.index)
+    clash = {m for m in set(modelled[reads]) if files[reads & (modelled == m)].nunique() > 1}
     if clash:
-        raise ColonsimError(f"{name}: runs on different centerline files named {', '.join(sorted(clash))}; give each "
+        raise ColonsimError(f"{name}: runs on different centerline files named "
+                            f"{', '.join(sorted(m.partition(':')[2] for m in clash))}; give each "
                             "patient's file its own name so the surrogate can tell the anatomies apart")
-    return segment.where(~reads, segment + ":" + stems)
+    return modelled
 
 
 def _rows(frame: pd.DataFrame, mask) -> str:

@@ -373,3 +373,34 @@ def test_the_cli_runs_an_adaptive_sweep(tmp_path, capsys, monkeypatch):
     text = capsys.readouterr().out
     assert code == 0 and "stopped: budget reached" in text and (out / FIGURE).is_file()
     assert len(pd.read_parquet(out / "results.parquet")) == 6
+
+
+def test_an_adaptive_sweep_on_a_patient_centerline_chooses_runs_on_it(tmp_path):
+    # the surrogate models a patient's file as segment "patient:<file name>": the candidates of
+    # the file's cases must be matched to that model, not to the catalog name "patient"
+    from colonsim.data import data_path
+    from colonsim.insertion.anatomy.patient_centerline import load_patient_centerline
+
+    example = str(data_path("anatomy", "sigmoid_loop.csv"))
+    toml = f"""
+[sweep]
+name = "adaptive-patient"
+seed = 2
+
+[fixed]
+segment = "patient"
+centerline = {json.dumps(example)}
+diameter_mm = {load_patient_centerline(example).median_diameter_mm}
+element_size_mm = 6.0
+
+[lhs]
+samples = 5
+scope_diameter_mm = [9, 13.5]
+friction = [0, 0.1]
+"""
+    report = run_adaptive_sweep(parse_sweep(toml, origin="adaptive-patient"), tmp_path / "p",
+                                AdaptiveSettings(budget=9, batch=2), workers=1, runner=standin_runner,
+                                progress=False, log=lambda *a: None)
+    assert report.stopped == "budget reached" and report.runs == 9
+    assert [len(r["chosen"]) for r in report.rounds] == [5, 2, 2]
+    assert set(report.rounds[-1]["cv"]) == {"patient:sigmoid_loop"}

@@ -39,7 +39,7 @@ from colonsim.insertion.case.scenario import InsertionCase
 from colonsim.insertion.study.adaptive_design import AdaptiveDesign, input_matrix
 from colonsim.insertion.study.sweep import run_sweep
 from colonsim.surrogate.acquisition import CRITERIA, greedy_batch
-from colonsim.surrogate.table import TARGET_LABELS
+from colonsim.surrogate.table import TARGET_LABELS, model_segment
 
 ROUNDS = "adaptive_rounds.json"
 FIGURE = "adaptive_rmse.png"
@@ -189,8 +189,9 @@ def choose_batch(design, model, target, segments, round_index, exclude, batch, c
     """The next ``batch`` cases among the round's candidates of ``segments``, with their picks."""
     by_segment = {}
     for case in design.candidates(round_index, exclude):
-        if case.segment in segments:
-            by_segment.setdefault(case.segment, []).append(case)
+        segment = model_segment(case.segment, case.centerline)  # a patient's file is a segment of its own
+        if segment in segments:
+            by_segment.setdefault(segment, []).append(case)
     groups, cases = [], []
     for segment, found in by_segment.items():
         domain, gp = model.model_for(segment, target)
