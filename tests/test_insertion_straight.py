@@ -21,17 +21,30 @@ def test_straight_push_leaves_the_colon_undeformed(straight_run):
     assert s["max_wall_stretch"] == pytest.approx(1.0, abs=1e-6)
 
 
-def test_the_push_reaches_the_far_end(straight_run):
+def test_the_push_reaches_the_far_end_and_rests(straight_run):
     ts = straight_run.timeseries
-    # the run ends once the tip crosses the far end ring's plane (x = 20 cm), checked every 10 ms
-    # of simulated time (6 mm of push at 0.6 m/s)
+    case = straight_run.case
+    # the run ends once the tip crosses the far end ring's plane (x = 20 cm), checked every mm of
+    # push; the scope then slows to rest over the stop distance and settles
     assert straight_run.summary["ended_by"] == "far_end"
-    assert 0.0 <= ts["tip_past_end_m"].iloc[-1] <= 0.0062
+    settle = ts[ts["phase"] == "settle"]
+    assert settle["time_s"].iloc[-1] - settle["time_s"].iloc[0] == pytest.approx(
+        2 * case.stop_distance_mm * 1e-3 / case.push_speed + case.settle_s, abs=2e-3)
+    crossing = ts["depth_m"][ts["tip_past_end_m"] >= 0.0].iloc[0]
+    assert ts["depth_m"].iloc[-1] - crossing == pytest.approx(case.stop_distance_mm * 1e-3, abs=1.1e-3)
     # the tip follows the pushed end: a stiff rod in a sheath, no axial buckling
     assert 0.20 + ts["tip_past_end_m"].iloc[-1] == pytest.approx(ts["depth_m"].iloc[-1], abs=0.002)
-    # the drive only overcomes the scope's mass-proportional drag (alpha m v = 5 * m * 0.6)
-    m = straight_run.model.rod.mass.sum()
-    assert ts["push_force_N"].iloc[-50:].mean() == pytest.approx(5.0 * m * 0.6, rel=0.1)
+
+
+def test_a_sliding_scope_is_not_dragged(straight_run):
+    """Beyond its ramp-up the drive pushes a scope through a straight frictionless tube with no
+    force (within 0.05 N): the scope's damping acts across its axis and on its strain rate only,
+    neither of which a sliding scope has (docs/model.md, "Time integration and damping")."""
+    ts = straight_run.timeseries
+    case = straight_run.case
+    plateau = ts[(ts["phase"] == "push") & (ts["time_s"] > case.ramp_s)]
+    assert len(plateau) > 100
+    assert plateau["push_force_N"].abs().max() < 0.05
 
 
 def test_cli_insert_writes_results_and_rejects_bad_input(tmp_path, capsys):

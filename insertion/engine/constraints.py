@@ -17,11 +17,15 @@ import numpy as np
 
 from colonsim.errors import ColonsimError
 
+#: kinds of velocity rows (:meth:`Constraint.velocity_rows`)
+FREE, ON_LINE, HELD = 0, 1, 2
+
 
 @numba.njit(cache=True)
-def line_constraint_kernel(x, v_new, reaction, mass, nodes, point, direction, s_min, s_max, dt):
-    """Remove the velocity across the line on the listed nodes lying within [s_min, s_max] along
-    it; add the reaction impulse / dt. Returns the total reaction force (3,)."""
+def line_constraint_kernel(x, v_new, reaction, mass, nodes, point, direction, s_min, s_max, dt, hold=1.0):
+    """Remove the velocity across the line (the fraction ``hold`` of it) on the listed nodes lying
+    within [s_min, s_max] along it; add the reaction impulse / dt. Returns the total reaction
+    force (3,)."""
     total = np.zeros(3)
     for j in range(nodes.shape[0]):
         i = nodes[j]
@@ -34,11 +38,21 @@ def line_constraint_kernel(x, v_new, reaction, mass, nodes, point, direction, s_
         for k in range(3):
             along += v_new[i, k] * direction[k]
         for k in range(3):
-            vc = along * direction[k]
+            vc = along * direction[k] + (1.0 - hold) * (v_new[i, k] - along * direction[k])
             r = mass[i] * (vc - v_new[i, k]) / dt
             reaction[i, k] += r
             total[k] += r
             v_new[i, k] = vc
+    return total
+
+
+@numba.njit(cache=True)
+def _row_sum(values, rows):
+    """Sum of ``values[rows]`` (k, 3) without gathering them first."""
+    total = np.zeros(3)
+    for j in range(rows.shape[0]):
+        for a in range(3):
+            total[a] += values[rows[j], a]
     return total
 
 
@@ -80,6 +94,14 @@ class Constraint(_Window):
         the staggered velocities, s."""
         raise NotImplementedError
 
+    def velocity_rows(self, t_mid, state):
+        """The constraint as rows of an implicit velocity update (a body with implicit damping,
+        :mod:`colonsim.insertion.engine.rod_damping`): ``(nodes, kind, vectors)``, the nodes it
+        constrains now, :data:`HELD` (the whole velocity is set: ``vectors`` (k, 3) are the target
+        velocities, m/s) or :data:`ON_LINE` (the velocity across a line is zero: ``vectors`` are the
+        line's unit directions)."""
+        raise NotImplementedError
+
 
 class FixedNodes(Constraint):
     """Nodes held at rest (zero velocity) while active.
@@ -98,7 +120,10 @@ class FixedNodes(Constraint):
         self._init_window(body, nodes, start, end)
 
     def constrain_rates(self, t_mid, state, dt_mid):
-        return state.reaction[self.nodes].sum(axis=0)
+        return _row_sum(state.reaction, self.nodes)
+
+    def velocity_rows(self, t_mid, state):
+        return self.nodes, HELD, np.zeros((len(self.nodes), 3))
 
 
 class PrescribedVelocity(Constraint):
@@ -139,6 +164,9 @@ class PrescribedVelocity(Constraint):
         state.v_new[idx] = vc
         return r.sum(axis=0)
 
+    def velocity_rows(self, t_mid, state):
+        return self.nodes, HELD, np.tile(self.velocity(t_mid), (len(self.nodes), 1))
+
 
 class LineConstraint(Constraint):
     """Nodes confined to a straight line (a rigid sheath) while they lie inside its extent.
@@ -158,10 +186,19 @@ class LineConstraint(Constraint):
         Candidate nodes (None = all nodes of the body).
     start, end : float
         Time window, s.
+    release : float
+        Let go gradually over this long after ``end``, s (0: at once): each step removes the
+        fraction ``1 - (t - end) / release`` of the velocity across the line, a damper that fades
+        out, so a part held against its load comes to its free equilibrium without a snap.
     """
 
-    def __init__(self, body, point, direction, extent=(-math.inf, math.inf), nodes=None, start=0.0, end=math.inf):
-        self._init_window(body, nodes, start, end)
+    def __init__(self, body, point, direction, extent=(-math.inf, math.inf), nodes=None, start=0.0, end=math.inf,
+                 release=0.0):
+        if not (math.isfinite(release) and release >= 0.0):
+            raise ColonsimError(f"line constraint release = {release!r} s must be >= 0; fix it.")
+        self._init_window(body, nodes, start, end + release)
+        self.held_until = float(end)
+        self.release = float(release)
         d = np.asarray(direction, dtype=np.float64).reshape(3)
         if not np.linalg.norm(d) > 0.0:
             raise ColonsimError("line constraint direction must be a non-zero vector; fix it.")
@@ -169,9 +206,23 @@ class LineConstraint(Constraint):
         self.point = np.asarray(point, dtype=np.float64).reshape(3)
         self.extent = (float(extent[0]), float(extent[1]))
 
+    def hold(self, t):
+        """Fraction of the velocity across the line removed at time ``t`` (1 while held)."""
+        if t < self.held_until or self.release == 0.0:
+            return 1.0
+        return max(0.0, 1.0 - (t - self.held_until) / self.release)
+
     def constrain_rates(self, t_mid, state, dt_mid):
         return line_constraint_kernel(state.x, state.v_new, state.reaction, self.body.mass, self.nodes, self.point,
-                                      self.direction, self.extent[0], self.extent[1], dt_mid)
+                                      self.direction, self.extent[0], self.extent[1], dt_mid, self.hold(t_mid))
+
+    def velocity_rows(self, t_mid, state):
+        if self.hold(t_mid) < 1.0:
+            raise ColonsimError("a line constraint let go gradually acts on explicit bodies only (a wall); give the "
+                                "implicitly damped body's constraint no release")
+        s = (state.x[self.nodes] - self.point) @ self.direction
+        nodes = self.nodes[(s >= self.extent[0]) & (s <= self.extent[1])]
+        return nodes, ON_LINE, np.tile(self.direction, (len(nodes), 1))
 
 
 class NodalLoad(_Window):

@@ -172,6 +172,13 @@ class Rod:
     inner_diameter : float, optional
         Inner diameter of a hollow section, m (0 = solid).
     name : str
+    damping_time : float, optional
+        Kelvin-Voigt damping time tau of the axial springs, s: a dashpot tau EA / L0 in parallel
+        with each (:mod:`colonsim.insertion.engine.rod_damping`, integrated implicitly by the
+        solver). 0 = none.
+    lateral_damping : float, optional
+        Mass-proportional damping of the velocity across the rod, 1/s (sliding along itself is
+        not damped; integrated implicitly by the solver). 0 = none.
 
     Attributes
     ----------
@@ -185,13 +192,17 @@ class Rod:
         Section area (m^2) and second moment of area (m^4).
     """
 
-    def __init__(self, nodes, diameter, youngs_modulus, density, inner_diameter=0.0, name="scope"):
+    def __init__(self, nodes, diameter, youngs_modulus, density, inner_diameter=0.0, name="scope", damping_time=0.0,
+                 lateral_damping=0.0):
         nodes = np.ascontiguousarray(nodes, dtype=np.float64)
         if nodes.ndim != 2 or nodes.shape[1] != 3 or len(nodes) < 3:
             raise ColonsimError(f"rod nodes must be an (n, 3) array with n >= 3, got shape {nodes.shape}.")
         for label, value in (("diameter", diameter), ("youngs_modulus", youngs_modulus), ("density", density)):
             if not (np.isfinite(value) and value > 0.0):
                 raise ColonsimError(f"rod {label} = {value!r} must be positive; fix it.")
+        for label, value in (("damping_time", damping_time), ("lateral_damping", lateral_damping)):
+            if not (np.isfinite(value) and value >= 0.0):
+                raise ColonsimError(f"rod {label} = {value!r} must be >= 0; fix it.")
         if not (np.isfinite(inner_diameter) and 0.0 <= inner_diameter < diameter):
             raise ColonsimError(
                 f"rod inner_diameter = {inner_diameter!r} m must lie in [0, diameter = {diameter}); fix it."
@@ -215,6 +226,9 @@ class Rod:
         self.rest_length = rest_length
         self.axial_stiffness = self.youngs_modulus * self.area / rest_length
         self.bending_stiffness = self.youngs_modulus * self.second_moment / (0.5 * (rest_length[:-1] + rest_length[1:]))
+        self.damping_time = float(damping_time)
+        self.dashpot = self.damping_time * self.axial_stiffness  # N s/m per segment
+        self.lateral_damping = float(lateral_damping)  # 1/s
 
         self._lumped_mass = np.zeros(n)
         seg_mass = self.density * self.area * rest_length
@@ -226,7 +240,7 @@ class Rod:
 
     @classmethod
     def straight(cls, length, diameter, youngs_modulus, density, spacing=5e-3, start=(0.0, 0.0, 0.0),
-                 direction=(1.0, 0.0, 0.0), inner_diameter=0.0, name="scope"):
+                 direction=(1.0, 0.0, 0.0), inner_diameter=0.0, name="scope", damping_time=0.0, lateral_damping=0.0):
         """Straight rod from ``start`` along ``direction``; nodes about ``spacing`` apart.
 
         ``length`` is the distance from the proximal node to the tip node (the hemispherical tip
@@ -241,7 +255,8 @@ class Rod:
         n_seg = max(2, int(round(length / spacing)))
         s = np.linspace(0.0, length, n_seg + 1)
         nodes = np.asarray(start, dtype=np.float64)[None, :] + s[:, None] * (d / norm)[None, :]
-        return cls(nodes, diameter, youngs_modulus, density, inner_diameter=inner_diameter, name=name)
+        return cls(nodes, diameter, youngs_modulus, density, inner_diameter=inner_diameter, name=name,
+                   damping_time=damping_time, lateral_damping=lateral_damping)
 
     @property
     def n_nodes(self):

@@ -279,6 +279,26 @@ class Shell:
         self._chunk_f = np.zeros((0,) + nodes.shape)  # per-thread nodal forces, sized on first use
         self._chunk_energy = np.zeros((0, 2))
         self._chunk_count = np.zeros((0, 2), dtype=np.int64)
+        self.hold(np.zeros(len(nodes), dtype=bool))
+
+    def hold(self, held):
+        """Tell the shell which nodes are held at rest (bool (n,)): the internal forces then leave
+        out the triangles and hinges all of whose nodes are held.
+
+        Held nodes stay at their stress-free rest positions, so such an element carries no force
+        (round-off apart), and what it would add lands on held nodes, whose velocity the solver
+        sets to zero anyway: the motion of every free node is unchanged, to the last bit when the
+        forces are added in one chunk (the elements keep their order). The colon models hold most
+        of their wall (rectum, descending colon, flexures, exits), which then costs nothing."""
+        held = np.asarray(held, dtype=bool)
+        tri_on = ~held[self.triangles].all(axis=1)
+        hinge_on = ~held[self.hinges].all(axis=1) if len(self.hinges) else np.zeros(0, dtype=bool)
+        if tri_on.all() and hinge_on.all():
+            self._active = (self.triangles, self.dm_inv, self.area0, self.hinges, self.hinge_stiffness, self.theta0)
+        else:
+            self._active = tuple(np.ascontiguousarray(a[on]) for a, on in (
+                (self.triangles, tri_on), (self.dm_inv, tri_on), (self.area0, tri_on), (self.hinges, hinge_on),
+                (self.hinge_stiffness, hinge_on), (self.theta0, hinge_on)))
 
     @property
     def n_nodes(self):
@@ -305,9 +325,10 @@ class Shell:
         # one chunk adds straight into f (a view), several into their own arrays summed below
         direct = n_chunks == 1 and f.dtype == np.float64 and f.flags.c_contiguous and f.shape == x.shape
         out = f.reshape((1,) + f.shape) if direct else self._chunk_f
+        tri, dm_inv, area0, hinges, hinge_stiffness, theta0 = self._active  # the elements not all held
         internal_forces_kernel(
-            x, self.triangles, self.dm_inv, self.area0, self.thickness, self._law, self._law_params,
-            self.hinges, self.hinge_stiffness, self.theta0, out, not direct, self._chunk_energy, self._chunk_count,
+            x, tri, dm_inv, area0, self.thickness, self._law, self._law_params, hinges, hinge_stiffness, theta0, out,
+            not direct, self._chunk_energy, self._chunk_count,
         )
         n_inv, n_bad = self._chunk_count.sum(axis=0)
         if n_inv:

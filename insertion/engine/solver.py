@@ -54,91 +54,8 @@ import math
 import numpy as np
 
 from colonsim.errors import ColonsimError
-from colonsim.insertion.engine.integrator_kernels import (advance_kernel, advance_kernel_serial, velocity_kernel,
-                                                          velocity_kernel_serial)
-
-
-class _BodyState:
-    """Positions, velocities and force/energy buffers of one body."""
-
-    def __init__(self, body, velocity, parallel_min_nodes):
-        n = len(body.x0)
-        self.body = body
-        # Nodal updates are a few flops per node: threads pay only for very large bodies.
-        self.parallel = n >= parallel_min_nodes
-        self.x = np.ascontiguousarray(body.x0, dtype=np.float64).copy()
-        self.v = np.zeros((n, 3)) if velocity is None else np.ascontiguousarray(velocity, dtype=np.float64).copy()
-        if self.v.shape != (n, 3):
-            raise ColonsimError(f"initial velocity of body '{body.name}' must have shape {(n, 3)}; got {self.v.shape}.")
-        self.v_new = np.zeros((n, 3))
-        self.f_int = np.zeros((n, 3))
-        self.f_con = np.zeros((n, 3))
-        self.f_ext = np.zeros((n, 3))
-        self.f_damp = np.zeros((n, 3))
-        self.reaction = np.zeros((n, 3))
-        self.fixed = np.zeros(n, dtype=np.uint8)
-        self.internal = 0.0
-        self.kinetic = 0.0
-        self.work_internal = 0.0
-        self.work_contact = 0.0
-        self.work_external = 0.0
-        self.work_reaction = 0.0
-        self.dissipated_damping = 0.0
-
-
-class History:
-    """Time series recorded by :meth:`ExplicitSolver.run`.
-
-    Attributes
-    ----------
-    time : (k,) array, s
-    step : (k,) int array
-    bodies : dict
-        ``bodies[name][quantity]`` arrays: ``kinetic``, ``internal``, ``dissipated`` (damping),
-        ``external_work`` (loads + constraint reactions), ``contact_work`` (work of contact forces on
-        the body), ``positions`` (k, n, 3) if recorded.
-    contacts : list of dict
-        Per contact: ``energy`` (penalty), ``dissipated`` (contact damping + friction),
-        ``friction_dissipated``, ``normal_force`` (sum of normal forces, N), ``force_on_rod`` (k, 3),
-        ``n_active``, ``n_candidates``.
-    reactions : list of (k, 3) arrays
-        Total reaction force of each constraint (N), in the solver's constraint order.
-    """
-
-    def __init__(self):
-        self._rows = []
-
-    def _append(self, row):
-        self._rows.append(row)
-
-    def _finish(self, body_names, n_contacts, n_constraints):
-        rows = self._rows
-        self.time = np.array([r["time"] for r in rows])
-        self.step = np.array([r["step"] for r in rows], dtype=np.int64)
-        self.bodies = {}
-        for name in body_names:
-            d = {}
-            for q in ("kinetic", "internal", "dissipated", "external_work", "contact_work"):
-                d[q] = np.array([r["bodies"][name][q] for r in rows])
-            if rows and "positions" in rows[0]["bodies"][name]:
-                d["positions"] = np.array([r["bodies"][name]["positions"] for r in rows])
-            self.bodies[name] = d
-        self.contacts = []
-        for c in range(n_contacts):
-            keys = rows[0]["contacts"][c].keys() if rows else ()
-            self.contacts.append({q: np.array([r["contacts"][c][q] for r in rows]) for q in keys})
-        self.reactions = [np.array([r["reactions"][j] for r in rows]).reshape(-1, 3) for j in range(n_constraints)]
-        return self
-
-    def total_energy_balance(self):
-        """Energy balance residual (k,), J: sum of kinetic + internal + dissipated energy of all bodies
-        and contacts minus all external work; constant (its initial value) for a consistent run."""
-        total = np.zeros_like(self.time)
-        for d in self.bodies.values():
-            total += d["kinetic"] + d["internal"] + d["dissipated"] - d["external_work"]
-        for c in self.contacts:
-            total += c["energy"] + c["dissipated"]
-        return total
+from colonsim.insertion.engine.body_state import BodyState, step_body
+from colonsim.insertion.engine.history import History
 
 
 class ExplicitSolver:
@@ -211,7 +128,7 @@ class ExplicitSolver:
         if any(a < 0.0 for a in self.damping.values()):
             raise ColonsimError("damping coefficients must be >= 0 1/s; fix them.")
         initial_velocity = initial_velocity or {}
-        self.state = {b.name: _BodyState(b, initial_velocity.get(b.name), parallel_min_nodes) for b in self.bodies}
+        self.state = {b.name: BodyState(b, initial_velocity.get(b.name), parallel_min_nodes) for b in self.bodies}
         self.fixed_time_step = time_step
         self.time_step_factor = float(time_step_factor)
         self.time_step_interval = int(time_step_interval)
@@ -227,6 +144,7 @@ class ExplicitSolver:
         self.dt = None
         self._dt_prev = None
         self._fixed_key = None
+        self._held_key = None
         self._energy0 = None
         self._work_in = 0.0
 
@@ -274,6 +192,22 @@ class ExplicitSolver:
             if on:
                 self.state[c.body.name].fixed[c.nodes] = 1
 
+    def _hold_elements(self, t):
+        """Tell bodies that leave held elements out (a shell: :meth:`Shell.hold`) which of their
+        nodes the constraints active at ``t`` hold, whenever that set changes (before the step's
+        forces, so a node released at ``t`` gets its elements' forces from this step on)."""
+        key = tuple(c.holds_at_rest and c.active(t) for c in self.constraints)
+        if key == self._held_key:
+            return
+        self._held_key = key
+        for b in self.bodies:
+            if hasattr(b, "hold"):
+                held = np.zeros(len(b.x0), dtype=bool)
+                for c, on in zip(self.constraints, key):
+                    if on and c.body is b:
+                        held[c.nodes] = True
+                b.hold(held)
+
     def _diverged(self, why):
         return ColonsimError(
             f"simulation diverged at t = {self.time:.6g} s (step {self.step}): {why}; "
@@ -290,6 +224,7 @@ class ExplicitSolver:
         dt = min(self.dt, max_step)
         dt_mid = dt if self._dt_prev is None else 0.5 * (dt + self._dt_prev)
         t = self.time
+        self._hold_elements(t)
         try:
             for s in self.state.values():
                 s.f_int[:] = 0.0
@@ -304,22 +239,12 @@ class ExplicitSolver:
             if load.active(t):
                 load.add_forces(t, self.state[load.body.name].f_ext)
         self._refresh_fixed(t)
-        for b in self.bodies:
-            s = self.state[b.name]
-            kernel = velocity_kernel if s.parallel else velocity_kernel_serial
-            kernel(s.v, s.f_int, s.f_con, s.f_ext, b.mass, s.fixed, self.damping[b.name], dt_mid, s.v_new, s.f_damp,
-                   s.reaction)
-        t_mid = t + 0.5 * dt
-        for c in self.constraints:
-            c.reaction = c.constrain_rates(t_mid, self.state[c.body.name], dt_mid) if c.active(t) else np.zeros(3)
         energy = 0.0
         work_in = 0.0
         for b in self.bodies:
             s = self.state[b.name]
-            kernel = advance_kernel if s.parallel else advance_kernel_serial
-            w_int, w_con, w_ext, w_damp, w_react, kinetic = kernel(
-                s.x, s.v, s.v_new, b.mass, s.f_int, s.f_con, s.f_ext, s.f_damp, s.reaction, dt_mid, dt
-            )
+            w_int, w_con, w_ext, w_damp, w_react, kinetic = step_body(
+                s, [c for c in self.constraints if c.body is b], self.damping[b.name], t, t + 0.5 * dt, dt_mid, dt)
             s.kinetic = kinetic
             s.work_internal += w_int
             s.work_contact += w_con

@@ -18,6 +18,7 @@ from colonsim.insertion.study.verification import Comparison
 GROUPS = {"rod": "Rod (scope): beam theory, Euler buckling, axial waves",
           "shell": "Shell (colon wall): inflation against thin-wall theory, bending against plate theory",
           "energy": "Energy accounting of the explicit integrator",
+          "damping": "Quasi-static devices: the scope's implicit damping, its push without drag, the sheath's lip",
           "contact": "Contact",
           "friction": "Regularised Coulomb friction",
           "law": "Every tissue law in the shell: homogeneous uniaxial tension and inflation in closed form",

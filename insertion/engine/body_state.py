@@ -1,0 +1,101 @@
+"""The state of one body in the explicit solver, and its velocity and position update.
+
+:class:`BodyState` holds positions, staggered velocities and the force and work buffers of a body.
+:func:`step_body` takes it through one (sub)step once its forces are known: the damped velocity
+update with the constraints (explicitly, or implicitly with the rod's dashpots and the
+constraints as rows: :mod:`colonsim.insertion.engine.rod_damping`), then the position update
+with the work of every force family (:mod:`colonsim.insertion.engine.integrator_kernels`).
+"""
+
+import numpy as np
+
+from colonsim.errors import ColonsimError
+from colonsim.insertion.engine.constraints import FREE, ON_LINE
+from colonsim.insertion.engine.integrator_kernels import (advance_kernel, advance_kernel_serial, velocity_kernel,
+                                                          velocity_kernel_serial)
+from colonsim.insertion.engine.rod_damping import damped_rod_velocity, merge_rows
+
+
+class BodyState:
+    """Positions, velocities and force/energy buffers of one body."""
+
+    def __init__(self, body, velocity, parallel_min_nodes):
+        n = len(body.x0)
+        self.body = body
+        # Nodal updates are a few flops per node: threads pay only for very large bodies.
+        self.parallel = n >= parallel_min_nodes
+        self.x = np.ascontiguousarray(body.x0, dtype=np.float64).copy()
+        self.v = np.zeros((n, 3)) if velocity is None else np.ascontiguousarray(velocity, dtype=np.float64).copy()
+        if self.v.shape != (n, 3):
+            raise ColonsimError(f"initial velocity of body '{body.name}' must have shape {(n, 3)}; got {self.v.shape}.")
+        self.v_new = np.zeros((n, 3))
+        self.f_int = np.zeros((n, 3))
+        self.f_con = np.zeros((n, 3))
+        self.f_ext = np.zeros((n, 3))
+        self.f_damp = np.zeros((n, 3))
+        self.reaction = np.zeros((n, 3))
+        self.fixed = np.zeros(n, dtype=np.uint8)
+        # a body with dashpots (a rod's strain-rate damping) takes an implicit velocity update
+        # with its constraints as rows (:mod:`colonsim.insertion.engine.rod_damping`)
+        dashpot = getattr(body, "dashpot", None)
+        self.implicit = dashpot is not None and (bool(np.any(dashpot > 0.0)) or body.lateral_damping > 0.0)
+        if self.implicit:
+            self.row_kind = np.zeros(n, dtype=np.int64)
+            self.row_dir = np.zeros((n, 3))
+            self.row_target = np.zeros((n, 3))
+        self.internal = 0.0
+        self.kinetic = 0.0
+        self.work_internal = 0.0
+        self.work_contact = 0.0
+        self.work_external = 0.0
+        self.work_reaction = 0.0
+        self.dissipated_damping = 0.0
+
+
+def share_reactions(rows, reaction):
+    """Each constraint's total reaction force (N) from a body's nodal reactions: in the solver's
+    order, a constraint takes the components of what is left at its nodes that it constrains."""
+    left = reaction.copy()
+    for c, nodes, kind, vectors in rows:
+        part = left[nodes]
+        if kind == ON_LINE:
+            part = part - np.einsum("ka,ka->k", part, vectors)[:, None] * vectors
+        left[nodes] -= part
+        c.reaction = part.sum(axis=0)
+
+
+def constraint_rows(s, constraints, t, t_mid):
+    """Every active constraint on body state ``s`` as velocity rows, merged per node
+    (:func:`~colonsim.insertion.engine.rod_damping.merge_rows`) in the solver's order; returns
+    ``[(constraint, nodes, kind, vectors), ...]`` for sharing out the reactions."""
+    s.row_kind[:] = FREE
+    rows = []
+    for c in constraints:
+        if not c.active(t):
+            continue
+        nodes, kind, vectors = c.velocity_rows(t_mid, s)
+        rows.append((c, nodes, kind, vectors))
+        merge_rows(s.row_kind, s.row_dir, s.row_target, nodes, kind, vectors)
+    return rows
+
+
+def step_body(s, constraints, alpha, t, t_mid, dt_mid, dt):
+    """Velocity update (damping ``alpha``, 1/s), ``constraints`` of this body (their ``reaction``
+    set), then positions; returns the work done on the body by each force family during the
+    step (internal, contact, external, damping, reaction; J) and its mid-step kinetic energy."""
+    b = s.body
+    if s.implicit:
+        rows = constraint_rows(s, constraints, t, t_mid)
+        damped_rod_velocity(s.x, s.v, s.f_int, s.f_con, s.f_ext, b.mass, alpha, b.lateral_damping, b.dashpot,
+                            s.row_kind, s.row_dir, s.row_target, dt_mid, s.v_new, s.f_damp, s.reaction)
+        share_reactions(rows, s.reaction)
+        for c in constraints:
+            if not c.active(t):
+                c.reaction = np.zeros(3)
+    else:
+        kernel = velocity_kernel if s.parallel else velocity_kernel_serial
+        kernel(s.v, s.f_int, s.f_con, s.f_ext, b.mass, s.fixed, alpha, dt_mid, s.v_new, s.f_damp, s.reaction)
+        for c in constraints:
+            c.reaction = c.constrain_rates(t_mid, s, dt_mid) if c.active(t) else np.zeros(3)
+    kernel = advance_kernel if s.parallel else advance_kernel_serial
+    return kernel(s.x, s.v, s.v_new, b.mass, s.f_int, s.f_con, s.f_ext, s.f_damp, s.reaction, dt_mid, dt)
