@@ -350,10 +350,15 @@ COLUMNS = {c.name: c for c in (
     Column("push_speed", _S, "m/s", "plateau push speed"),
     Column("ramp_s", _S, "s", "speed-change ramp"),
     Column("relax_s", _S, "s", "relax pause of straighten-relax-push"),
+    Column("stop_distance_mm", _S, "mm", "push over which the scope slows to rest at the end of the run"),
+    Column("settle_s", _S, "s", "time the scope is held still at the end before the final values are read"),
+    Column("settle_lateral_damping", _S, "1/s", "lateral damping of the scope while it settles at rest"),
     Column("exit_length_mm", _S, "mm", "fixed colon after the last mobile piece"),
     Column("sheath_reserve_mm", _S, "mm", "scope length kept in the sheath"),
     Column("colon_damping", _S, "1/s", "mass-proportional damping of the colon"),
     Column("scope_damping", _S, "1/s", "mass-proportional damping of the scope"),
+    Column("scope_lateral_damping", _S, "1/s", "mass-proportional damping of the scope's velocity across its axis"),
+    Column("scope_axial_damping_s", _S, "s", "Kelvin-Voigt damping time of the scope's axial springs"),
     Column("record_interval_s", _S, "s", "simulated time between recorded samples"),
     Column("time_step_factor", _S, "", "safety factor on the stable time step"),
     Column("final_deformation_cm", _O, "cm", "colon deformation at the end of the run", DEFAULT_TARGET,
@@ -366,15 +371,17 @@ COLUMNS = {c.name: c for c in (
            "deformation at point B [cm]"),
     Column("point_C_cm", _O, "cm", "deformation at point C, the largest value after B (RSJ)", DEFAULT_TARGET,
            "deformation at point C [cm]"),
-    Column("peak_contact_force_N", _O, "N", "largest total contact force over the run", DEFAULT_TARGET,
-           "peak contact force [N]"),
-    Column("peak_push_force_N", _O, "N", "largest push force over the run", DEFAULT_TARGET, "peak push force [N]"),
+    Column("peak_contact_force_N", _O, "N", "largest total contact force over the push, averaged over 5 mm of push "
+                                            "(docs/model.md, \"Outputs\")", DEFAULT_TARGET, "peak contact force [N]"),
+    Column("peak_push_force_N", _O, "N", "largest push force over the push, averaged over 5 mm of push", DEFAULT_TARGET,
+           "peak push force [N]"),
     Column("max_wall_stretch", _O, "", "largest wall stretch over the run", DEFAULT_TARGET,
            "maximum wall stretch"),
-    Column("quasi_static", _O, "", "kinetic / internal energy below 10 % on most samples for both bodies, the "
-                                   "scope's imposed sliding set aside (docs/model.md, \"Time integration and "
-                                   "damping\")"),
-    Column("quasi_static_literal", _O, "", "the same with that sliding counted: it fails for nearly every insertion"),
+    Column("ringing_ratio", _O, "", "RMS of the push force about its 1 cm moving average over its mean, over the push "
+                                    "from the first contact (docs/model.md, \"Time integration and damping\")"),
+    Column("quasi_static", _O, "", "the ringing ratio is below 0.1: the push force follows the push without ringing"),
+    Column("kinetic_energy_check", _O, "", "kinetic / internal energy below 10 % on most samples for both bodies, the "
+                                           "scope's imposed sliding set aside (information: it passed runs that rang)"),
     Column("ended_by", _O, "", "why the run ended: tip_past_end, far_end, length_used or jam "
                                "(docs/model.md, \"Loading\")"),
     Column("end_depth_cm", _O, "cm", "pushed depth where the run ended"),

@@ -289,7 +289,7 @@ def insert(cases, out: Path, vtu=False, snapshot_every=0.02, show=True, max_step
     from tqdm import tqdm
 
     from colonsim.files import save_figure, write_csv
-    from colonsim.insertion.case.results import comparison_table, insertion_figure, write_insertion
+    from colonsim.insertion.case.results import comparison_table, insertion_figure, quasi_static_words, write_insertion
     from colonsim.insertion.case.run_budget import check_run_budget
     from colonsim.insertion.case.scenario import run_insertion
 
@@ -299,17 +299,15 @@ def insert(cases, out: Path, vtu=False, snapshot_every=0.02, show=True, max_step
         print(f"{case.segment.upper()} {case.scope.upper()}: {budget.describe()}", flush=True)
         # the bar follows simulated time, which costs wall time evenly (depth does not: the
         # push ramps up and RSF/THF pause), so its time left is meaningful
-        chunk_s = 0.01
         bar = tqdm(total=round(budget.simulated_s * 1e3), unit="ms", disable=None if show else True,
                    dynamic_ncols=True, leave=False, mininterval=0.5, desc=f"{case.segment} {case.scope} (simulated ms)")
 
-        def progress(tip_arc, tip_end, bar=bar):
-            bar.update(min(round(chunk_s * 1e3), bar.total - bar.n))
+        def progress(time_s, tip_arc, tip_end, bar=bar):
+            bar.update(max(min(round(time_s * 1e3), bar.total) - bar.n, 0))
             bar.set_postfix_str(f"tip {100 * tip_arc:.1f}/{100 * tip_end:.1f} cm", refresh=False)
 
         try:
-            r = run_insertion(case, progress=progress, snapshot_interval=snapshot_every if vtu else None,
-                              chunk_s=chunk_s)
+            r = run_insertion(case, progress=progress, snapshot_interval=snapshot_every if vtu else None)
         finally:
             bar.close()
         folder = out / f"{case.segment}_{r.summary['scope']['name'].replace(' ', '')}"
@@ -319,10 +317,8 @@ def insert(cases, out: Path, vtu=False, snapshot_every=0.02, show=True, max_step
         pts = ", ".join(f"{k} {v['deformation_cm']:.2f} cm" for k, v in s["points_cm"].items() if v is not None)
         print(f"{case.segment.upper()} {s['scope']['name']:>8}: final deformation {s['final_deformation_cm']:.2f} cm, "
               f"max {s['max_deformation_cm']:.2f} cm ({pts}); peak contact {s['peak_contact_force_N']:.2f} N, "
-              f"peak push {s['peak_push_force_N']:.2f} N; quasi-static {'holds' if s['quasi_static']['holds'] else 'does NOT hold'} "
-              f"(KE/IE < 10 %: colon {100 * s['quasi_static']['fraction_below_10pct']['colon']:.0f} %, "
-              f"scope {100 * s['quasi_static']['fraction_below_10pct']['scope']:.0f} % of samples without its imposed "
-              f"sliding); ended: {s['end']['reason']} at {s['end']['depth_cm']:.1f} cm; "
+              f"peak push {s['peak_push_force_N']:.2f} N; {quasi_static_words(s['quasi_static'])}; "
+              f"ended: {s['end']['reason']} at {s['end']['depth_cm']:.1f} cm; "
               f"{s['steps']} steps in {s['wall_time_s']:.1f} s -> {folder}/")
     table, figure = comparison_table(results), insertion_figure(results)  # both made before either file is replaced
     write_csv(out / "comparison.csv", table)

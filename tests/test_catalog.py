@@ -69,7 +69,7 @@ def test_every_colon_model_builds_and_its_facts_reach_the_case(name):
     assert built.rod.rest_length.sum() == pytest.approx(length, rel=1e-12)
     assert (model.scope_length is None) == model.reads_centerline
     phases = [p.name for p in built.push.phases]
-    assert phases == (["straighten", "stop", "relax", "push"] if model.straightens else ["push"])
+    assert phases == (["straighten", "stop", "relax", "push", "settle"] if model.straightens else ["push", "settle"])
 
 
 def test_colon_model_facts_reach_sweep_and_surrogate():

@@ -19,7 +19,7 @@ def rsf_run():
 def test_phases_follow_the_mobile_part(rsf_run):
     ts, model = rsf_run.timeseries, rsf_run.model
     phases = list(dict.fromkeys(ts["phase"]))
-    assert phases == ["straighten", "stop", "relax", "push"]
+    assert phases == ["straighten", "stop", "relax", "push", "settle"]
     held = ts[ts["phase"].isin(["straighten", "stop"])]
     relax = ts[ts["phase"] == "relax"]
     # straightening pushes to the end of the mobile part (the sigmoid and its half-fillet) ...

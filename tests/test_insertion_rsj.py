@@ -53,10 +53,11 @@ def _check_passed_into_exit(run):
     assert s["ended_by"] == "tip_past_end", s["end"]
     tip, p0, axis = _tip_and_exit(run)
     along = np.dot(tip - p0, axis)
-    # the run ends at the first check (every 10 ms) after the tip crosses the plane 2 cm past the
-    # junction; a tip held back at the junction snaps forward when it slips in (measured: 1.1 cm
-    # beyond the plane for the 13.3 mm scope), so allow 2 cm
-    assert PAST_JUNCTION <= along <= PAST_JUNCTION + 0.02
+    # the push stops once the tip has crossed the plane 2 cm past the junction; held still, the
+    # scope then lets go of the loop it made in the sigmoid and its tip slides on into the exit
+    # (measured: 5.8 cm past the junction for the 13.3 mm scope), never through its far end
+    assert PAST_JUNCTION <= along <= run.case.exit_length_mm * 1e-3
+    assert run.timeseries["kinetic_scope_J"].iloc[-1] < 1e-3 * run.timeseries["kinetic_scope_J"].max()
     # inside the fixed lumen: the tip's centre within D/2 less the scope radius of the exit's axis
     lateral = np.linalg.norm(tip - p0 - along * axis)
     assert lateral < 0.5 * (run.case.diameter_mm * 1e-3 - run.model.scope.diameter) + 1e-3
@@ -75,7 +76,7 @@ def test_runs_pass_into_the_exit_and_stay_quasi_static(rsj_runs):
     for r in rsj_runs.values():
         _check_passed_into_exit(r)
         s = r.summary
-        assert s["quasi_static"]["fraction_below_10pct"]["colon"] > 0.5
-        assert s["quasi_static"]["holds"]
+        assert s["quasi_static"]["energy"]["fraction_below_10pct"]["colon"] > 0.5
+        assert s["quasi_static"]["holds"], s["quasi_static"]
         assert r.timeseries.notna().all().all()
         assert 1.0 < s["max_wall_stretch"] < 2.0

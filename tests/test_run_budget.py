@@ -43,7 +43,7 @@ def test_a_wall_in_the_wrong_unit_is_refused_with_the_cause_and_the_limit_can_be
 
 
 def test_other_causes_are_named():
-    with pytest.raises(ColonsimError, match=r"the slow push \(0.005 m/s, default 0.6\)"):
+    with pytest.raises(ColonsimError, match=rf"the slow push \(0.005 m/s, default {InsertionCase().push_speed:g}\)"):
         check_run_budget(InsertionCase(**COARSE, push_speed=0.005), max_steps=100_000)
 
 

@@ -169,8 +169,9 @@ def test_store_rows_follow_the_contract_and_the_table_is_replaced_atomically(tmp
     row = result_row(case, outcome)
     assert row["material"] == "" and row["scope"] == "10.5" and row["scope_diameter_mm"] == pytest.approx(10.5)
     # a failed run has no outputs: NaN numbers, False checks, no ending
-    assert row["quasi_static"] is False and row["quasi_static_literal"] is False and row["ended_by"] == ""
-    assert all(math.isnan(row[k]) for k in OUTPUTS if not k.startswith("quasi_static") and k != "ended_by")
+    assert row["quasi_static"] is False and row["kinetic_energy_check"] is False and math.isnan(row["ringing_ratio"]) and row["ended_by"] == ""
+    assert all(math.isnan(row[k]) for k in OUTPUTS
+               if k not in ("quasi_static", "kinetic_energy_check", "ended_by"))
     with SweepStore(tmp_path) as store:
         store.record(case, outcome)
         assert store.finished() == {case.key()} and store.finished(retry_failed=True) == set()

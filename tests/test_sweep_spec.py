@@ -35,16 +35,19 @@ def test_validation_preset_pairs_each_model_with_the_thesis_runs():
     or the flexure angle, so the report can pair them."""
     thesis = {c.key(): c for c in load_sweep(preset="thesis").cases}
     cases = load_sweep(preset="validation").cases
-    assert len(cases) == 16 and len({c.key() for c in cases}) == 16
+    assert len(cases) == 24 and len({c.key() for c in cases}) == 24
     changes = {}
     for c in cases:
-        base = {"element_size_mm": 3.0, "push_speed": 0.6, "flexure_angle_deg": 90.0}
+        base = {"element_size_mm": 3.0, "push_speed": InsertionCase().push_speed, "flexure_angle_deg": 90.0}
         varied = [k for k, v in base.items() if getattr(c, k) != v]
         assert len(varied) == 1
         partner = InsertionCase(**{**c.to_dict(), varied[0]: base[varied[0]]})
         assert partner.key() in thesis
         changes.setdefault(varied[0], set()).add(c.segment)
     assert changes["element_size_mm"] == changes["push_speed"] == {"rsj", "rsf", "thf", "thf-fixed"}
+    # the rate check halves the default speed for every scope of one case per model
+    halved = [c for c in cases if c.push_speed != InsertionCase().push_speed]
+    assert {c.push_speed for c in halved} == {0.5 * InsertionCase().push_speed} and len(halved) == 12
     assert changes["flexure_angle_deg"] == {"rsf", "thf"}
 
 

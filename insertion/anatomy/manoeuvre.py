@@ -9,6 +9,11 @@ the scope is never jerked (a step in speed launches an axial wave of amplitude r
   constrained until the pushed depth reaches the end of the mobile part ("straighten", "stop"),
   let the system relax at rest with the constraint released ("birth and death"), then push on
   through the flexure.
+- Every run ends at rest ("settle"): the push slows to a stop over a given push distance and the
+  scope is held still for a settling time, so the final state is an equilibrium at the final
+  depth, not a snapshot of the motion. A run that ends before its planned depth because the tip
+  passed the end stops so from where it is (:meth:`PushProfile.stop`); a jam ends at once, under
+  its load.
 """
 
 from __future__ import annotations
@@ -30,6 +35,7 @@ class Phase:
     end: float
     speed: float
     lateral_constraint: bool = False
+    ramp: float | None = None  # s: this phase's speed change (None: the profile's ramp)
 
 
 def _transition(tau, ramp):
@@ -46,7 +52,8 @@ def _transition(tau, ramp):
 class PushProfile:
     """Push speed against time built from phases; speed changes take ``ramp`` seconds.
 
-    Each phase's speed is reached ``ramp`` after its start (a change starts at the phase start).
+    Each phase's speed is reached ``ramp`` after its start (a change starts at the phase start),
+    or its own ``Phase.ramp``.
     """
 
     phases: list
@@ -59,7 +66,7 @@ class PushProfile:
         self._levels = []
         previous = 0.0
         for p in self.phases:
-            self._levels.append((p.start, p.speed - previous))
+            self._levels.append((p.start, p.speed - previous, self.ramp if p.ramp is None else p.ramp))
             previous = p.speed
 
     @property
@@ -68,11 +75,29 @@ class PushProfile:
 
     def speed(self, t):
         """Push speed at time ``t``, m/s."""
-        return sum(dv * _transition(t - t0, self.ramp)[0] for t0, dv in self._levels)
+        return sum(dv * _transition(t - t0, ramp)[0] for t0, dv, ramp in self._levels)
 
     def depth(self, t):
         """Insertion depth (distance pushed) at time ``t``, m."""
-        return sum(dv * _transition(t - t0, self.ramp)[1] for t0, dv in self._levels)
+        return sum(dv * _transition(t - t0, ramp)[1] for t0, dv, ramp in self._levels)
+
+    @property
+    def settle_start(self):
+        """Start of the closing ``settle`` phase, s (None: the profile does not end at rest)."""
+        last = self.phases[-1]
+        return last.start if last.name == SETTLE else None
+
+    def stop(self, t, distance, hold):
+        """End the push from time ``t``: slow to rest over ``distance`` (m) of push and hold still
+        for ``hold`` seconds (the ``settle`` phase); later phases are dropped."""
+        if self.settle_start is not None and self.settle_start <= t:
+            return
+        kept = [p for p in self.phases if p.start <= t]
+        kept[-1] = Phase(kept[-1].name, kept[-1].start, t, kept[-1].speed, kept[-1].lateral_constraint, kept[-1].ramp)
+        v = self.speed(t)
+        ramp = 2.0 * distance / v if v > 0.0 else 0.0
+        self.phases = kept + [Phase(SETTLE, t, t + ramp + hold, 0.0, ramp=ramp)]
+        self.__post_init__()
 
     @property
     def lateral_constraint_end(self):
@@ -87,20 +112,43 @@ class PushProfile:
         return self.phases[-1]
 
 
+SETTLE = "settle"
+
+
+def _settle(phases, speed, stop_distance, settle):
+    """``phases`` of a push ending at speed, plus a ``settle`` phase slowing to rest over
+    ``stop_distance`` (m) and holding for ``settle`` s; unchanged when both are 0."""
+    if settle <= 0.0 and stop_distance <= 0.0:
+        return phases
+    if not (np.isfinite(settle) and settle >= 0.0 and np.isfinite(stop_distance) and stop_distance >= 0.0):
+        raise ColonsimError(f"settle time {settle!r} s and stop distance {stop_distance!r} m must be >= 0")
+    last = phases[-1]
+    ramp = 2.0 * stop_distance / speed
+    end = last.end - stop_distance / speed  # the plateau ends where slowing down covers the stop distance
+    if end <= last.start:
+        raise ColonsimError(f"the stop distance {stop_distance:g} m is longer than the last push; shorten it")
+    return phases[:-1] + [Phase(last.name, last.start, end, last.speed, last.lateral_constraint, last.ramp),
+                          Phase(SETTLE, end, end + ramp + settle, 0.0, ramp=ramp)]
+
+
 def _time_to_push(distance, speed, ramp):
     """Time for a push from rest to cover ``distance`` (the ramp covers speed * ramp / 2)."""
     return 0.5 * ramp + distance / speed
 
 
-def continuous_push(depth, speed=0.6, ramp=0.05) -> PushProfile:
-    """RSJ: push from rest to ``depth`` (m) at ``speed`` (m/s), starting with a ramp (s)."""
+def continuous_push(depth, speed=0.6, ramp=0.05, stop_distance=0.0, settle=0.0) -> PushProfile:
+    """RSJ: push from rest to ``depth`` (m) at ``speed`` (m/s), starting with a ramp (s); with a
+    ``stop_distance`` (m) or ``settle`` time (s), the push comes to rest at ``depth`` and holds."""
     _check(depth, speed, ramp)
-    return PushProfile([Phase("push", 0.0, _time_to_push(depth, speed, ramp), speed)], ramp)
+    phases = [Phase("push", 0.0, _time_to_push(depth, speed, ramp), speed)]
+    return PushProfile(_settle(phases, speed, stop_distance, settle), ramp)
 
 
-def straighten_relax_push(straighten_depth, depth, speed=0.6, ramp=0.05, relax=0.1) -> PushProfile:
+def straighten_relax_push(straighten_depth, depth, speed=0.6, ramp=0.05, relax=0.1, stop_distance=0.0,
+                          settle=0.0) -> PushProfile:
     """RSF/THF: push to ``straighten_depth`` with the lateral constraint, slow to a stop there with
-    it still on, relax for ``relax`` seconds with it released, then push on to ``depth`` (m).
+    it still on, relax for ``relax`` seconds with it released, then push on to ``depth`` (m)
+    (coming to rest there and holding, as :func:`continuous_push`).
 
     Phases: ``straighten`` (at speed) and ``stop`` (the slow-down ramp, ending at rest at
     ``straighten_depth``) hold the mobile part (``lateral_constraint``); ``relax`` and ``push`` do not.
@@ -115,10 +163,11 @@ def straighten_relax_push(straighten_depth, depth, speed=0.6, ramp=0.05, relax=0
     t2 = t1 + ramp
     t3 = t2 + relax
     t4 = t3 + _time_to_push(depth - straighten_depth, speed, ramp)
-    return PushProfile([Phase("straighten", 0.0, t1, speed, lateral_constraint=True),
-                        Phase("stop", t1, t2, 0.0, lateral_constraint=True),
-                        Phase("relax", t2, t3, 0.0),
-                        Phase("push", t3, t4, speed)], ramp)
+    phases = [Phase("straighten", 0.0, t1, speed, lateral_constraint=True),
+              Phase("stop", t1, t2, 0.0, lateral_constraint=True),
+              Phase("relax", t2, t3, 0.0),
+              Phase("push", t3, t4, speed)]
+    return PushProfile(_settle(phases, speed, stop_distance, settle), ramp)
 
 
 def _check(depth, speed, ramp):

@@ -47,10 +47,12 @@ class Colonoscope:
                 f"({colon_diameter * 1e3:.1f} mm); choose a thinner scope or a larger --diameter"
             )
 
-    def rod(self, start, direction, length, spacing=5e-3):
-        """The scope as a straight :class:`colonsim.insertion.engine.rod.Rod` from ``start`` (proximal end)."""
+    def rod(self, start, direction, length, spacing=5e-3, damping_time=0.0, lateral_damping=0.0):
+        """The scope as a straight :class:`colonsim.insertion.engine.rod.Rod` from ``start`` (proximal
+        end), with its numerical damping (``damping_time``, s; ``lateral_damping``, 1/s)."""
         return Rod.straight(length, self.diameter, self.youngs_modulus, self.density, spacing=spacing,
-                            start=start, direction=direction, name=f"scope {self.name}")
+                            start=start, direction=direction, name=f"scope {self.name}", damping_time=damping_time,
+                            lateral_damping=lateral_damping)
 
     def describe(self) -> dict:
         return {"name": self.name, "diameter_mm": self.diameter * 1e3, "youngs_modulus_Pa": self.youngs_modulus,

@@ -52,6 +52,102 @@ def characteristic_points(time, depth, deformation, prominence=0.05):
     return points
 
 
+RINGING_WINDOW = 0.01  # m of push: the moving average the push force rings about
+RINGING_LIMIT = 0.1  # a run whose ringing ratio is below this is quasi-static (docs/model.md)
+PEAK_WINDOW = 0.005  # m of push: peak forces are maxima of the force averaged over this much push
+# The other quasi-static checks (docs/model.md, "Time integration and damping"), which need more
+# than one run: half the push speed or a 2 mm mesh may change a deformation by this fraction and a
+# peak force by this one; forces below FORCE_FLOOR_N are not judged (nothing measurable).
+DEFORMATION_TOLERANCE = 0.05
+FORCE_TOLERANCE = 0.10
+FORCE_FLOOR_N = 0.5
+
+
+def depth_weights(depth):
+    """Weight of each sample in an integral over the push: half the depth to its neighbours (m).
+
+    A sample taken while the scope stands still (a pause) weighs nothing, and a run sampled at
+    another push speed weighs its samples alike per millimetre of push."""
+    z = np.asarray(depth, dtype=float)
+    w = np.zeros_like(z)
+    if z.size > 1:
+        w[1:-1] = 0.5 * (z[2:] - z[:-2])
+        w[0] = 0.5 * (z[1] - z[0])
+        w[-1] = 0.5 * (z[-1] - z[-2])
+    return w
+
+
+def depth_trend(depth, values, window):
+    """Depth-weighted moving average of ``values`` over [z - window/2, z + window/2] at every
+    sample's depth z, and the push each average covers (m). ``depth`` non-decreasing."""
+    z = np.asarray(depth, dtype=float)
+    w = depth_weights(z)
+    cw = np.concatenate(([0.0], np.cumsum(w)))
+    cf = np.concatenate(([0.0], np.cumsum(w * np.asarray(values, dtype=float))))
+    lo = np.searchsorted(z, z - 0.5 * window, side="left")
+    hi = np.searchsorted(z, z + 0.5 * window, side="right")
+    covered = cw[hi] - cw[lo]
+    return (cf[hi] - cf[lo]) / np.maximum(covered, 1e-300), covered
+
+
+def peak_trend(depth, values, window=PEAK_WINDOW):
+    """Largest value of ``values`` averaged over ``window`` of push (docs/model.md, "Outputs"), or
+    NaN when the push is shorter than the window.
+
+    The largest recorded sample would be a statistic of the sampling, not of the push: a run
+    sampled every millisecond at half the speed has twice the samples per millimetre, and a
+    release (a tip slipping past a junction) puts a spike of a millisecond or two into the
+    contact force that the sampling catches or misses. The average over 5 mm of push keeps every
+    feature of the force along the push that is wider than that."""
+    trend, covered = depth_trend(depth, values, window)
+    full = covered >= 0.5 * window
+    return float(trend[full].max()) if full.any() else float("nan")
+
+
+def ringing_ratio(depth, push_force, in_contact, window=RINGING_WINDOW):
+    """How much the push force rings about its trend, once contact has begun (docs/model.md,
+    "Time integration and damping").
+
+    The push force is a function of the pushed depth in a quasi-static run. Every sample is
+    weighted by the depth it stands for (:func:`depth_weights`), so the measure is an integral
+    over the push: a pause, when the scope is not advancing (the stop and relax of RSF/THF),
+    weighs nothing, and a run sampled at another push speed measures the same thing. The trend
+    is the force's depth-weighted mean over ``window`` of push (:func:`depth_trend`).
+
+    Parameters
+    ----------
+    depth, push_force : (n,) arrays
+        Pushed depth (m, non-decreasing) and push force (N) per sample.
+    in_contact : (n,) bool array
+        Samples with scope-wall contact; the measure starts at the first.
+    window : float
+        Push distance of the moving average, m (1 cm).
+
+    Returns
+    -------
+    dict with ``ratio`` (RMS about the trend over the mean push force; NaN when the push after
+    first contact is shorter than the window or its mean force is not positive), ``rms_N``,
+    ``mean_N`` and ``push_cm`` (the push distance measured).
+    """
+    z = np.asarray(depth, dtype=float)
+    f = np.asarray(push_force, dtype=float)
+    contact = np.asarray(in_contact, dtype=bool)
+    empty = {"ratio": float("nan"), "rms_N": float("nan"), "mean_N": float("nan"), "push_cm": 0.0}
+    if not contact.any():
+        return empty
+    first = int(np.argmax(contact))
+    z, f = z[first:], f[first:]
+    if z.size < 3 or z[-1] - z[0] < window:
+        return {**empty, "push_cm": float((z[-1] - z[0]) * 100) if z.size else 0.0}
+    w = depth_weights(z)
+    trend, _ = depth_trend(z, f, window)
+    total = float(w.sum())
+    mean = float(np.sum(w * f) / total)
+    rms = float(np.sqrt(np.sum(w * (f - trend) ** 2) / total))
+    ratio = rms / mean if mean > 0.0 else float("nan")
+    return {"ratio": ratio, "rms_N": rms, "mean_N": mean, "push_cm": total * 100}
+
+
 def quasi_static_fraction(kinetic, internal, ratio=0.1, floor=1e-12):
     """Fraction of recorded samples with kinetic / internal energy below ``ratio``.
 

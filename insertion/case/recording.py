@@ -28,6 +28,12 @@ class InsertionRecorder:
         self._next_snapshot = 0.0
         g = model.geometry
         self._mobile = model.mobile_nodes
+        # held triangles stay at rest (stretch 1): the largest stretch is that of the others
+        held = np.zeros(len(model.shell.x0), dtype=bool)
+        held[model.fixed_nodes] = True
+        moving = ~held[model.shell.triangles].all(axis=1)
+        self._triangles = model.shell.triangles[moving] if moving.any() else model.shell.triangles[:1]
+        self._dm_inv = model.shell.dm_inv[moving] if moving.any() else model.shell.dm_inv[:1]
         self._tip = model.rod.tip_node
         self._tip0 = model.rod.x0[self._tip].copy()
         s = np.linspace(0.0, g.centerline_length, max(200, int(g.centerline_length / 1e-3)))
@@ -54,7 +60,7 @@ class InsertionRecorder:
             "dt_s": solver.dt,
             "depth_m": m.push.depth(solver.time),
             "deformation_m": deformation,
-            "max_stretch": float(principal_stretches(colon.x, m.shell.triangles, m.shell.dm_inv).max()),
+            "max_stretch": float(principal_stretches(colon.x, self._triangles, self._dm_inv).max()),
             "tip_displacement_m": float(np.linalg.norm(tip - self._tip0)),
             "tip_arc_m": float(self._arc[np.argmin(((self._arc_points - tip) ** 2).sum(axis=1))]),
             "tip_past_end_m": float(np.dot(tip - self._end_point, self._end_axis)),

@@ -20,7 +20,6 @@ Dask workers need the package, and the material and centerline files the cases n
 
 from __future__ import annotations
 
-import dataclasses
 import math
 import multiprocessing
 import os
@@ -33,74 +32,18 @@ from pathlib import Path
 
 import pandas as pd
 
-from colonsim import catalog
 from colonsim.errors import ColonsimError
 from colonsim.files import atomic_path, check_output_folder, write_json
 from colonsim.provenance import code_version
 from colonsim.insertion.case.run_budget import DEFAULT_MAX_STEPS, check_sweep_budget
-from colonsim.insertion.case.scenario import InsertionCase, InsertionResult
-from colonsim.insertion.anatomy.scopes import colonoscope
-from colonsim.insertion.study.material_samples import material_columns
+from colonsim.insertion.case.scenario import InsertionResult
+from colonsim.insertion.study.sweep_rows import IDENTITY, OUTPUTS, input_columns, input_row, result_row
 from colonsim.insertion.study.sweep_worker import execute, start_worker
 
 TABLE = "results.parquet"
 SWEEP_DOCUMENT = "sweep.json"
 LOCK = ".sweep.lock"
 DIED = "worker process died during this run (killed or out of memory)"
-# the table's columns, units and meanings: colonsim.catalog.COLUMNS
-IDENTITY = catalog.columns(catalog.PROVENANCE)
-OUTPUTS = catalog.columns(catalog.OUTPUT)
-
-
-def input_columns() -> list:
-    """Every InsertionCase field (from the dataclass), the derived scope diameter and wall moduli."""
-    return [f.name for f in dataclasses.fields(InsertionCase)] + ["scope_diameter_mm", catalog.WALL_MU0, catalog.WALL_C11]
-
-
-def input_row(case) -> dict:
-    """The input columns of ``case``'s results row (:func:`input_columns`)."""
-    row = {}
-    for f in dataclasses.fields(InsertionCase):
-        value = getattr(case, f.name)
-        if value is None:  # a column keeps one type: "" for absent strings, NaN for absent numbers
-            value = "" if "str" in str(f.type) else math.nan
-        row[f.name] = value
-    row["scope_diameter_mm"] = round(colonoscope(case.scope).diameter * 1e3, 6)  # 11.3, not 11.299999999999999
-    row.update(material_columns(case))  # drawn parameters as JSON text, mu0 and C11 in kPa
-    return row
-
-
-def _outputs(summary) -> dict:
-    """The scalar outputs of a summary (None for a failed run): NaN when undefined, cm and N."""
-    def number(value):
-        return float(value) if isinstance(value, (int, float)) else math.nan
-
-    summary = summary or {}
-    points = summary.get("points_cm") or {}
-    out = {name: number(summary.get(name)) for name in OUTPUTS}
-    for p in "ABC":
-        out[f"point_{p}_cm"] = number((points.get(p) or {}).get("deformation_cm"))
-    qs = summary.get("quasi_static") or {}
-    # KE/IE < 10 % for both bodies, the scope's imposed sliding set aside (colonsim.insertion.case.outcomes)
-    out["quasi_static"] = bool(qs.get("holds", False))
-    out["quasi_static_literal"] = bool((qs.get("literal") or {}).get("holds", False))
-    end = summary.get("end") or {}
-    out["ended_by"] = str(summary.get("ended_by", ""))  # tip_past_end, far_end, length_used or jam
-    for name, key in (("end_depth_cm", "depth_cm"), ("end_push_force_N", "push_force_N"),
-                      ("end_contact_force_N", "contact_force_N")):
-        out[name] = number(end.get(key))
-    return out
-
-
-def result_row(case, outcome, timeseries_path="") -> dict:
-    """The table row of one run (``outcome`` from :func:`colonsim.insertion.study.sweep_worker.execute`)."""
-    ok = outcome["status"] == "ok"
-    return {"key": case.key(), "status": outcome["status"], "error": outcome.get("error", ""),
-            "wall_time_s": float(outcome["wall_time_s"]), "timeseries_path": timeseries_path if ok else "",
-            "finished_at": outcome["finished_at"], "git_commit": code_version()["git_commit"] or "",
-            **input_row(case), **_outputs(outcome.get("summary") if ok else None)}
-
-
 class SweepStore:
     """The results of a sweep folder: read at start, one row added (atomically) per finished run.
 
@@ -224,7 +167,7 @@ class SweepStore:
         frame = frame[first + [c for c in frame.columns if c not in first]]
         frame["quasi_static"] = frame["quasi_static"].fillna(False).astype(bool)
         # rows written before these columns existed: unknown (<NA> / ""), not "failed"
-        frame["quasi_static_literal"] = frame["quasi_static_literal"].astype("boolean")
+        frame["kinetic_energy_check"] = frame["kinetic_energy_check"].astype("boolean")
         frame["ended_by"] = frame["ended_by"].fillna("").astype(str)
         return frame.reset_index(drop=True)
 

@@ -1,0 +1,191 @@
+"""The inputs of one insertion (docs/model.md): :class:`InsertionCase`, its checks and its key.
+
+Every input has the model's default; mm, degrees, m/s and s are the user's units (SI inside the
+solver). A sweep's results table has one input column per field (:mod:`colonsim.insertion.study.sweep`).
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import math
+from dataclasses import asdict, dataclass
+
+from colonsim.catalog import colon_model
+from colonsim.errors import ColonsimError
+from colonsim.insertion.anatomy.centerline_file import load_centerline_points
+from colonsim.insertion.anatomy.colon_segments import check_patient_tube
+from colonsim.insertion.anatomy.patient_centerline import SMOOTHING_MM, load_patient_centerline
+from colonsim.insertion.anatomy.scopes import colonoscope
+from colonsim.insertion.case.case_material import case_material
+
+# cases that do not use them stay what they were (existing sweep folders resume).
+LATER_FIELDS = ("centerline", "centerline_smoothing_mm", "material_parameters")
+
+
+@dataclass
+class InsertionCase:
+    """Every input of one insertion (user units: mm, degrees, m/s, 1/s).
+
+    Attributes
+    ----------
+    segment : str
+        A colon model of :data:`colonsim.catalog.COLON_MODELS` (rsj, rsf, thf, thf-fixed, straight,
+        patient).
+    centerline : str or None
+        A patient's centerline CSV (docs/model.md, "A patient's centerline"), for and only for
+        segment ``patient``. With a ``diameter_mm`` column the file's profile runs and
+        ``diameter_mm`` must state its median (to 0.1 mm).
+    centerline_smoothing_mm : float
+        RMS tolerance of the smoothed centerline (**assumption** 1 mm, about a CT voxel).
+    scope : str
+        ``utc``, ``pdc``, ``sdc`` or an outer diameter in mm.
+    diameter_mm : float
+        Colon inner diameter (the source: 23 or 36 for RSJ; 36 assumed elsewhere).
+    angle_deg : float
+        alpha of RSF or beta of THF (ignored for RSJ).
+    flexure_angle_deg : float
+        Turn of the splenic (RSF) or hepatic (THF) flexure (**assumption** 90).
+    exit_length_mm : float
+        Fixed colon after the last mobile piece (**assumption** 100; for THF the ascending colon).
+    friction : float
+        Coulomb coefficient mu between scope and wall.
+    wall_thickness_mm : float
+        Colon wall thickness (**assumption** 2 mm).
+    material : str or None
+        Material JSON (``colonsim calibrate`` output); None = the source's parameters.
+    element_size_mm, scope_spacing_mm : float
+        Wall triangle size and scope node spacing.
+    push_speed : float
+        Plateau push speed, m/s (0.3: half the source's 0.6, which is not quasi-static here;
+        docs/model.md, "Time integration and damping").
+    sheath_reserve_mm : float
+        Scope length that stays in the sheath at the end of the push (**assumption** 20).
+    ramp_s, relax_s : float
+        Speed-change ramp and the relax pause of RSF/THF, s.
+    stop_distance_mm, settle_s : float
+        The push ends at rest: it slows to a stop over ``stop_distance_mm`` of push and the scope
+        is held still for ``settle_s``; the final values are read then.
+    colon_damping, scope_damping : float
+        Mass-proportional damping, 1/s (the scope's drags its push: 0 by default).
+    scope_lateral_damping : float
+        Mass-proportional damping of the scope's velocity across its axis, 1/s (sliding along
+        itself is not damped).
+    scope_axial_damping_s : float
+        Kelvin-Voigt damping time of the scope's axial springs, s (a dashpot tau EA / L0 on each;
+        it damps the axial waves that make the push force ring and does not drag a sliding scope).
+    record_interval_s : float
+        Simulated time between recorded samples.
+    time_step_factor : float
+        Safety factor on the stable time step.
+    material_parameters : dict or None
+        {name: Pa} replacing the parameters of ``material`` (its law stays); set by a sweep's
+        ``[material]`` section (:mod:`colonsim.insertion.study.material_samples`). None = the file's.
+    """
+
+    segment: str = "rsj"
+    centerline: str | None = None
+    centerline_smoothing_mm: float = SMOOTHING_MM
+    scope: str = "sdc"
+    diameter_mm: float = 36.0
+    angle_deg: float = 0.0
+    flexure_angle_deg: float = 90.0
+    friction: float = 0.0
+    wall_thickness_mm: float = 2.0
+    material: str | None = None
+    element_size_mm: float = 3.0
+    scope_spacing_mm: float = 5.0
+    push_speed: float = 0.3
+    ramp_s: float = 0.4
+    relax_s: float = 0.1
+    stop_distance_mm: float = 5.0
+    settle_s: float = 0.1
+    settle_lateral_damping: float = 200.0
+    exit_length_mm: float = 100.0
+    sheath_reserve_mm: float = 20.0
+    colon_damping: float = 120.0
+    scope_damping: float = 0.0
+    scope_lateral_damping: float = 200.0
+    scope_axial_damping_s: float = 3e-3
+    record_interval_s: float = 1e-3
+    time_step_factor: float = 0.9
+    material_parameters: dict | None = None
+
+    def validate(self):
+        """Raise :class:`ColonsimError` naming the first bad input and its fix."""
+        model = colon_model(self.segment)
+        if model.reads_centerline and self.centerline is None:
+            raise ColonsimError(f"segment {self.segment!r} is a patient's centerline; give the file "
+                                "(--centerline FILE, or centerline = \"FILE\" in a sweep)")
+        if self.centerline is not None and not model.reads_centerline:
+            raise ColonsimError(f"a centerline file is given for segment {self.segment!r}, which has its own shape; "
+                                "use segment 'patient' (--centerline implies it) or drop the centerline")
+        checks = [
+            ("diameter_mm", self.diameter_mm, 10.0, 80.0, "colon inner diameter in mm (23 or 36 in the source)"),
+            ("wall_thickness_mm", self.wall_thickness_mm, 0.2, 10.0, "wall thickness in mm (2 assumed)"),
+            ("element_size_mm", self.element_size_mm, 0.5, 20.0, "wall element size in mm (3 by default)"),
+            ("scope_spacing_mm", self.scope_spacing_mm, 1.0, 50.0, "scope node spacing in mm (5 by default)"),
+            ("push_speed", self.push_speed, 1e-3, 5.0, "push speed in m/s (0.3; 0.6 in the source)"),
+            ("colon_damping", self.colon_damping, 0.0, 1e4, "damping in 1/s"),
+            ("scope_damping", self.scope_damping, 0.0, 1e4, "damping in 1/s"),
+            ("scope_lateral_damping", self.scope_lateral_damping, 0.0, 1e4, "damping in 1/s"),
+            ("scope_axial_damping_s", self.scope_axial_damping_s, 0.0, 0.1, "Kelvin-Voigt damping time in s (3e-3)"),
+            ("stop_distance_mm", self.stop_distance_mm, 0.0, 100.0, "push distance to slow to rest, mm (5)"),
+            ("settle_s", self.settle_s, 0.0, 10.0, "settling time at rest at the end, s (0.1)"),
+            ("settle_lateral_damping", self.settle_lateral_damping, 0.0, 1e4, "damping in 1/s"),
+            ("record_interval_s", self.record_interval_s, 1e-6, 1.0, "recording interval in s"),
+            ("time_step_factor", self.time_step_factor, 0.01, 1.0, "a safety factor in (0, 1]"),
+            ("ramp_s", self.ramp_s, 0.0, 10.0, "ramp duration in s (0.4)"),
+            ("relax_s", self.relax_s, 1e-3, 10.0, "relax duration in s (0.1 by default)"),
+            ("exit_length_mm", self.exit_length_mm, 0.0, 300.0, "fixed exit length in mm (100 by default)"),
+            ("flexure_angle_deg", self.flexure_angle_deg, 1.0, 180.0, "flexure turn in degrees (90 by default)"),
+            ("sheath_reserve_mm", self.sheath_reserve_mm, 0.0, 200.0, "scope length kept in the sheath, mm (20)"),
+        ]
+        for name, value, lo, hi, what in checks:
+            if not (isinstance(value, (int, float)) and math.isfinite(value) and lo <= value <= hi):
+                raise ColonsimError(f"{name} = {value!r} is outside [{lo:g}, {hi:g}]; give the {what}")
+        if not (math.isfinite(self.friction) and 0.0 <= self.friction <= 2.0):
+            raise ColonsimError(f"friction = {self.friction!r} must lie in [0, 2] (the source used 0, 0.05, 0.1)")
+        if self.element_size_mm > self.diameter_mm / 3:
+            raise ColonsimError(f"element size {self.element_size_mm} mm is too coarse for a {self.diameter_mm} mm colon; "
+                                "use at most a third of the diameter")
+        if self.material_parameters is not None:
+            case_material(self.material, self.material_parameters)
+        scope = colonoscope(self.scope)
+        if self.centerline is None:
+            scope.check_fits(self.diameter_mm * 1e-3)
+            return
+        centerline = self.patient_centerline()
+        check_patient_tube(centerline, self.diameter_mm * 1e-3, self.wall_thickness_mm * 1e-3)
+        if centerline.diameter_profile is None:
+            scope.check_fits(self.diameter_mm * 1e-3)
+        else:
+            s, d = centerline.diameter_profile
+            i = int(d.argmin())
+            if scope.diameter >= d[i]:
+                raise ColonsimError(f"scope {scope.name} ({scope.diameter * 1e3:.1f} mm) does not fit the narrowest "
+                                    f"lumen of {self.centerline}, {d[i] * 1e3:.1f} mm at {s[i] * 100:.1f} cm (line "
+                                    f"{centerline.source.lines[i]}); choose a thinner scope or check that diameter")
+
+    def patient_centerline(self):
+        """The smoothed centerline of ``centerline`` (cached per file state), or None."""
+        if self.centerline is None:
+            return None
+        return load_patient_centerline(self.centerline, self.centerline_smoothing_mm)
+
+    def to_dict(self) -> dict:
+        return asdict(self)
+
+    def key(self) -> str:
+        """A short hash of the inputs (identifies a run in sweeps and output folders).
+
+        A centerline enters as the digest of its content (points, labels, names, diameters), not
+        its path: a moved or re-saved file keeps its runs, an edited one gets new ones."""
+        inputs = self.to_dict()
+        defaults = InsertionCase()
+        for name in LATER_FIELDS:
+            if inputs[name] == getattr(defaults, name):
+                del inputs[name]
+        if self.centerline is not None:
+            inputs["centerline"] = "sha256:" + load_centerline_points(self.centerline).digest()
+        return hashlib.sha256(json.dumps(inputs, sort_keys=True).encode()).hexdigest()[:12]

@@ -1,0 +1,102 @@
+"""The summary of one insertion run (docs/model.md, "Outputs"): why and where it ended, its
+scalar outcomes, and its quasi-static check.
+"""
+
+from __future__ import annotations
+
+from colonsim.catalog import colon_model
+from colonsim.insertion.anatomy.manoeuvre import SETTLE
+from colonsim.insertion.case.outcomes import (JAM_PROGRESS, JAM_PUSH, PEAK_WINDOW, RINGING_LIMIT, RINGING_WINDOW,
+                                              characteristic_points, peak_trend, quasi_static_fraction, ringing_ratio)
+from colonsim.insertion.engine.material import REFERENCE_MATERIAL_PATH
+from colonsim.provenance import code_version
+
+ENDINGS = {
+    "tip_past_end": "the tip passed the fixed end",
+    "far_end": "the tip reached the model's far end",
+    "length_used": "the scope's available length was pushed in",
+    "jam": f"the tip jammed: under {JAM_PROGRESS * 1e3:g} mm of tip progress over {JAM_PUSH * 100:g} cm of push "
+           "while the push force rose",
+}
+
+
+def end_state(model, ts, ended_by) -> dict:
+    """Where and under which forces a run ended (``ended_by`` explained, depth, tip, forces)."""
+    last = ts.iloc[-1]
+    reason = ENDINGS[ended_by]
+    if ended_by == "length_used" and colon_model(model.case.segment).must_reach_end:
+        reason += " before the tip passed the fixed end"
+    return {"reason": reason, "depth_cm": float(last["depth_m"] * 100), "tip_arc_cm": float(last["tip_arc_m"] * 100),
+            "push_force_N": float(last["push_force_N"]), "contact_force_N": float(last["contact_force_N"])}
+
+
+def tip_passed_end(sample, model) -> bool:
+    """Has the tip crossed the end plane, near the end of the colon (not beside its entry)?"""
+    near = sample["tip_arc_m"] >= model.tip_end - 1e-3 * model.case.diameter_mm
+    return bool(near and sample["tip_past_end_m"] >= 0.0)
+
+
+def _finite(value):
+    """``value``, or None where it is undefined (NaN): JSON holds no NaN."""
+    return float(value) if value == value else None
+
+
+def quasi_static_summary(ts, energy_fractions, sliding) -> dict:
+    """The run's quasi-static check (docs/model.md, "Time integration and damping"): the ringing
+    ratio of the push force over the push (the closing settle phase left out: the scope is held
+    there), and the kinetic/internal energy fractions as information."""
+    pushing = (ts["phase"] != SETTLE).to_numpy()
+    ring = ringing_ratio(ts["depth_m"].to_numpy()[pushing], ts["push_force_N"].to_numpy()[pushing],
+                         ts["contact_nodes"].to_numpy()[pushing] > 0)
+    return {
+        "criterion": f"ringing ratio below {RINGING_LIMIT:g}: RMS of the push force about its moving average over "
+                     f"{RINGING_WINDOW * 100:g} cm of push, over its mean, from the first contact to the end of the push",
+        "ringing_ratio": _finite(ring["ratio"]),
+        "push_force_rms_N": _finite(ring["rms_N"]),
+        "mean_push_force_N": _finite(ring["mean_N"]),
+        "measured_push_cm": ring["push_cm"],
+        "holds": bool(ring["ratio"] < RINGING_LIMIT),
+        "energy": {"meaning": "kinetic / internal energy < 10 % on most (> 50 %) of the samples, per body, the scope's "
+                              "kinetic energy taken less that of sliding along itself at the push speed; information, "
+                              "not the criterion (it passed runs that rang)",
+                   "fraction_below_10pct": {"colon": energy_fractions["colon"], "scope": sliding},
+                   "holds": bool(energy_fractions["colon"] > 0.5 and sliding > 0.5)},
+    }
+
+
+def summarize(model, ts, wall_s, build_s) -> dict:
+    """The summary of one run: deformation, points A/B/C, forces, energy check, sizes, inputs."""
+    points = characteristic_points(ts["time_s"], ts["depth_m"], ts["deformation_m"])
+    push = ts[ts["phase"] != SETTLE]
+    qs = {body: quasi_static_fraction(ts[f"kinetic_{body}_J"], ts[f"internal_{body}_J"]) for body in ("colon", "scope")}
+    sliding = quasi_static_fraction(ts["kinetic_scope_sliding_J"], ts["internal_scope_J"])
+    g = model.geometry
+    return {
+        "inputs": model.case.to_dict(),
+        "key": model.case.key(),
+        "code": code_version(),
+        "scope": {**model.scope.describe(), "length_cm": float(model.rod.rest_length.sum() * 100)},
+        "pushed_depth_cm": float(ts["depth_m"].iloc[-1] * 100),
+        "tip_end_cm": float(model.tip_end * 100),
+        "final_deformation_cm": float(ts["deformation_m"].iloc[-1] * 100),
+        "max_deformation_cm": float(ts["deformation_m"].max() * 100),
+        "points_cm": {k: (None if v is None else {"deformation_cm": v["deformation_m"] * 100,
+                                                    "depth_cm": v["depth_m"] * 100, "time_s": v["time_s"]})
+                      for k, v in points.items()},
+        "peak_contact_force_N": _finite(peak_trend(push["depth_m"], push["contact_force_N"])),
+        "peak_push_force_N": _finite(peak_trend(push["depth_m"], push["push_force_N"])),
+        "peak_forces_sampled_N": {"contact": float(ts["contact_force_N"].max()), "push": float(ts["push_force_N"].max()),
+                                  "meaning": "largest recorded samples (every record_interval_s), before averaging "
+                                             f"over {PEAK_WINDOW * 1e3:g} mm of push"},
+        "max_wall_stretch": float(ts["max_stretch"].max()),
+        "final_tip_arc_cm": float(ts["tip_arc_m"].iloc[-1] * 100),
+        "quasi_static": quasi_static_summary(ts, qs, sliding),
+        "simulated_time_s": float(ts["time_s"].iloc[-1]),
+        "steps": int(model.solver.step),
+        "time_step_s": {"min": float(ts["dt_s"].min()), "max": float(ts["dt_s"].max())},
+        "wall_time_s": float(wall_s),
+        "build_time_s": float(build_s),
+        "mesh": {**g.summary(), "scope_nodes": int(model.rod.n_nodes), "hinges": int(len(model.shell.hinges))},
+        "material": {"law": model.shell.material.law, **model.shell.material.named_parameters,
+                     "file": model.case.material or str(REFERENCE_MATERIAL_PATH)},
+    }

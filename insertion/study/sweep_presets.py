@@ -1,0 +1,97 @@
+"""The sweep presets (``colonsim sweep --preset NAME``, docs/sweeps.md): TOML text in the format
+:mod:`colonsim.insertion.study.sweep_spec` reads, one entry per preset.
+"""
+
+PRESETS = {
+    # The source's Chapter V: RSJ D23/D36 x 3 scopes x mu 0/0.05/0.1 (18 runs); RSF alpha and THF
+    # beta 0/30/45 x 3 scopes at mu 0 (18); fixed THF x 3 scopes (3). The scopes have the
+    # diameters of the source's meshes (9.2 / 11.1 / 13.3 mm), not the catalogue's (9.2 / 11.3 / 12.8).
+    "thesis": """
+[sweep]
+name = "thesis"
+description = "Every insertion of the source's Chapter V: RSJ, RSF, THF and fixed THF, with the scope diameters of its meshes (9.2 / 11.1 / 13.3 mm)"
+
+[[grid]]
+segment = "rsj"
+scope = ["9.2", "11.1", "13.3"]
+diameter_mm = [23, 36]
+friction = [0, 0.05, 0.1]
+
+[[grid]]
+segment = ["rsf", "thf"]
+scope = ["9.2", "11.1", "13.3"]
+angle_deg = [0, 30, 45]
+
+[[grid]]
+segment = "thf-fixed"
+scope = ["9.2", "11.1", "13.3"]
+""",
+    # The validation report's own runs beside the thesis sweep: the mesh pair (2 mm against the
+    # thesis sweep's 3 mm) of the thickest scope in one case per colon model, the rate check (half
+    # the default push speed, 0.15 against 0.3 m/s) of every scope in one case per colon model,
+    # and the flexure-angle sensitivity of RSF/THF at alpha = beta = 45 deg (135 and 180 deg
+    # against the default 90), for the thinnest and the thickest scope.
+    "validation": """
+[sweep]
+name = "validation"
+description = "Mesh pair, rate check and flexure-angle sensitivity beside the thesis sweep (scope meshes 9.2 / 11.1 / 13.3 mm)"
+
+[[grid]]
+segment = "rsj"
+scope = "13.3"
+diameter_mm = 36
+element_size_mm = 2
+
+[[grid]]
+segment = "rsj"
+scope = ["9.2", "11.1", "13.3"]
+diameter_mm = 36
+push_speed = 0.15
+
+[[grid]]
+segment = ["rsf", "thf"]
+scope = "13.3"
+angle_deg = 45
+element_size_mm = 2
+
+[[grid]]
+segment = ["rsf", "thf"]
+scope = ["9.2", "11.1", "13.3"]
+angle_deg = 45
+push_speed = 0.15
+
+[[grid]]
+segment = "thf-fixed"
+scope = "13.3"
+element_size_mm = 2
+
+[[grid]]
+segment = "thf-fixed"
+scope = ["9.2", "11.1", "13.3"]
+push_speed = 0.15
+
+[[grid]]
+segment = ["rsf", "thf"]
+scope = ["9.2", "13.3"]
+angle_deg = 45
+flexure_angle_deg = [135, 180]
+""",
+    # A few runs of a few seconds each on a coarse wall mesh: for tests and for checking a setup.
+    "smoke": """
+[sweep]
+name = "smoke"
+description = "Three fast runs on a coarse 7.5 mm wall mesh (tests, setup checks); not physics"
+
+[fixed]
+element_size_mm = 7.5
+
+[[grid]]
+segment = "straight"
+scope = "pdc"
+
+[[grid]]
+segment = "rsj"
+scope = ["utc", "sdc"]
+friction = [0.05]
+""",
+}
