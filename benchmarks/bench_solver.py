@@ -10,12 +10,21 @@ per-step time, element updates per second per core
 projected wall time of a 0.5 s simulated push at the solver's time step.
 
 Run: ``python benchmarks/bench_solver.py [--steps 2000] [--threads 2] [--mesh 3e-3] [--rod-spacing 5e-3] [--repeat 1]
-[--baseline CHECKOUT]``
+[--devices] [--baseline CHECKOUT | --baseline-python PYTHON]``
+
+``--devices`` gives the scope the insertion's quasi-static devices (docs/model.md, "Time
+integration and damping": implicit axial and lateral damping instead of mass damping, the
+sheath's lip), so the per-step time is that of today's insertions.
 
 On a shared machine single timings vary by +-15 %: ``--repeat 5`` times five runs of ``--steps``
 steps each (one model, continuing in time) and reports the median. ``--baseline`` builds the same
 model with another checkout's engine in the same process and alternates their timed runs, so both
 see the same machine load; it prints the ratio and whether the final positions are identical.
+It needs the layout before the one-package restructure (two ``colonsim`` packages cannot share a
+process): for a later checkout, ``--baseline-python`` names the Python of an environment where
+that checkout is installed (``pip install -e CHECKOUT`` in a venv); this script then runs in it
+as a child process that builds the same model and times its runs when told, alternating with
+this process's runs, and the two compare the final positions through a file.
 """
 
 import argparse
@@ -65,8 +74,9 @@ SCOPE_LENGTH = 0.7
 SCOPE_D = 12.8e-3
 
 
-def build(e, mesh_size=3e-3, rod_spacing=5e-3, friction=0.1):
-    """The reference model built with engine ``e``: solver, shell, rod, contact."""
+def build(e, mesh_size=3e-3, rod_spacing=5e-3, friction=0.1, devices=False):
+    """The reference model built with engine ``e``: solver, shell, rod, contact (``devices``: the
+    scope with the insertion's quasi-static damping and the sheath's lip, which needs this checkout)."""
     nodes, tri, ring = e.straight_tube(TUBE_LENGTH, LUMEN + WALL, mesh_size)
     colon = e.Shell(nodes, tri, WALL, e.load_material(e.REFERENCE_MATERIAL_PATH), density=1040.0, name="colon")
     ends = np.flatnonzero((ring == 0) | (ring == ring.max()))
@@ -74,19 +84,29 @@ def build(e, mesh_size=3e-3, rod_spacing=5e-3, friction=0.1):
     reach = 0.5 * SCOPE_D + 0.5 * WALL
     y_axis = -(0.5 * (LUMEN + WALL) - reach + 1e-4)
     start = (0.25 - SCOPE_LENGTH, y_axis, 0.0)
-    scope = e.Rod.straight(SCOPE_LENGTH, SCOPE_D, 16e6, 2944.0, spacing=rod_spacing, start=start)
-    contact = e.RodShellContact(scope, colon, friction=friction)
+    extra = {}
+    if devices:
+        from colonsim.insertion.case.insertion_case import InsertionCase
+
+        case = InsertionCase()
+        extra = {"damping_time": case.scope_axial_damping_s, "lateral_damping": case.scope_lateral_damping}
+    scope = e.Rod.straight(SCOPE_LENGTH, SCOPE_D, 16e6, 2944.0, spacing=rod_spacing, start=start, **extra)
+    contacts = [e.RodShellContact(scope, colon, friction=friction)]
+    if devices:
+        from colonsim.insertion.engine.sheath_lip import SheathLip
+
+        contacts.append(SheathLip(scope, start, (1.0, 0.0, 0.0), -start[0] - 0.005))
     push = e.PrescribedVelocity(scope, [0], (0.6, 0.0, 0.0), ramp=0.02)
     sheath = e.LineConstraint(scope, start, (1.0, 0.0, 0.0), extent=(-1.0, -start[0] - 0.005))
     weight = e.NodalLoad(scope, np.arange(scope.n_nodes), np.outer(scope.mass * 9.81, (0.0, -1.0, 0.0)))
     sim = e.ExplicitSolver(
         [scope, colon],
-        contacts=[contact],
+        contacts=contacts,
         constraints=[e.FixedNodes(colon, ends), push, sheath],
         loads=[weight],
-        damping={"colon": 20.0, "scope": 20.0},
+        damping={"colon": 20.0, "scope": 0.0 if devices else 20.0},
     )
-    return sim, colon, scope, contact
+    return sim, colon, scope, contacts[0]
 
 
 class TimedModel:
@@ -94,7 +114,8 @@ class TimedModel:
 
     def __init__(self, e, args):
         t0 = time.perf_counter()
-        self.sim, self.colon, self.scope, self.contact = build(e, mesh_size=args.mesh, rod_spacing=args.rod_spacing)
+        self.sim, self.colon, self.scope, self.contact = build(e, mesh_size=args.mesh, rod_spacing=args.rod_spacing,
+                                                               devices=args.devices)
         for _ in range(20):  # compile and build the candidate list
             self.sim.advance()
         self.warm = time.perf_counter() - t0
@@ -123,6 +144,43 @@ class TimedModel:
         return sorted(self.runs)[len(self.runs) // 2]
 
 
+def serve(model, args):
+    """The child of ``--baseline-python``: time a run of N steps for every line "N" on stdin, print
+    its wall time; at end of input, save the final positions to the file ``--serve`` names."""
+    print("ready", flush=True)
+    for line in sys.stdin:
+        model.run(int(line))
+        print(model.runs[-1][0], flush=True)
+    np.savez(args.serve, colon=model.sim.state["colon"].x, scope=model.sim.state["scope"].x)
+
+
+class ChildModel:
+    """The reference model in a child process running another environment's engine."""
+
+    def __init__(self, args):
+        import subprocess
+        import tempfile
+
+        self._positions = Path(tempfile.mkdtemp()) / "baseline_positions.npz"
+        command = [str(args.baseline_python), __file__, "--serve", str(self._positions), "--mesh", str(args.mesh),
+                   "--rod-spacing", str(args.rod_spacing)] + (["--threads", str(args.threads)] if args.threads else [])
+        self._child = subprocess.Popen(command, stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True)
+        if self._child.stdout.readline().strip() != "ready":
+            sys.exit(f"--baseline-python {args.baseline_python}: the child did not start (see its error above)")
+        self.runs = []
+
+    def run(self, steps):
+        self._child.stdin.write(f"{steps}\n")
+        self._child.stdin.flush()
+        self.runs.append(float(self._child.stdout.readline()))
+
+    def finish(self):
+        self._child.stdin.close()
+        self._child.wait()
+        x = np.load(self._positions)
+        return sorted(self.runs)[len(self.runs) // 2], {"colon": x["colon"], "scope": x["scope"]}
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--steps", type=int, default=2000, help="timed steps")
@@ -131,6 +189,11 @@ def main():
     parser.add_argument("--mesh", type=float, default=3e-3, help="wall triangle size, m")
     parser.add_argument("--rod-spacing", type=float, default=5e-3, help="scope node spacing, m")
     parser.add_argument("--repeat", type=int, default=1, help="timed runs of --steps steps; the median is reported")
+    parser.add_argument("--devices", action="store_true", help="the scope with the insertion's quasi-static devices")
+    parser.add_argument("--baseline-python", type=Path, default=None,
+                        help="the Python of an environment with another (package-layout) checkout installed: it "
+                             "runs the same model in a child process, timed run for run alternately")
+    parser.add_argument("--serve", type=Path, default=None, help=argparse.SUPPRESS)  # the child of --baseline-python
     parser.add_argument("--baseline", type=Path, default=None,
                         help="a checkout in the layout before the colonsim package (e.g. commit 49ddc62): its "
                              "engine runs the same model in this process, timed run for run alternately")
@@ -139,11 +202,16 @@ def main():
         numba.set_num_threads(args.threads)
     cores = numba.get_num_threads()
     model = TimedModel(engine(CURRENT), args)
+    if args.serve:
+        return serve(model, args)
     base = TimedModel(baseline_engine(args.baseline), args) if args.baseline else None
+    child = ChildModel(args) if args.baseline_python else None
     for _ in range(max(args.repeat, 1)):
         model.run(args.steps)
         if base is not None:
             base.run(args.steps)
+        if child is not None:
+            child.run(args.steps)
     sim, colon, scope, contact = model.sim, model.colon, model.scope, model.contact
     wall, cand, shell_wall = model.median()
     elements = len(colon.triangles) + len(colon.hinges) + len(scope.segments)
@@ -165,6 +233,13 @@ def main():
         print(f"per step in each of the {len(model.runs)} runs (median reported above): "
               + ", ".join(f"{w / args.steps * 1e3:.3f}" for w, _, _ in model.runs) + " ms")
     print(f"candidate rebuilds: {contact.n_rebuilds}; tip at x = {sim.state['scope'].x[scope.tip_node, 0]:.4f} m")
+    if child is not None:
+        child_wall, child_x = child.finish()
+        same = np.array_equal(sim.state["colon"].x, child_x["colon"]) and np.array_equal(sim.state["scope"].x,
+                                                                                           child_x["scope"])
+        print(f"baseline {args.baseline_python}: per step {child_wall / args.steps * 1e3:.3f} ms (runs "
+              + ", ".join(f"{w / args.steps * 1e3:.3f}" for w in child.runs) + " ms); this checkout / baseline = "
+              f"{wall / child_wall:.3f}; final positions {'identical' if same else 'DIFFER'}")
     if base is not None:
         base_wall = base.median()[0]
         same = np.array_equal(sim.state["colon"].x, base.sim.state["colon"].x) and np.array_equal(

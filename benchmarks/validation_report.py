@@ -36,11 +36,14 @@ ROOT = Path(__file__).resolve().parents[1]
 from colonsim.errors import ColonsimError
 from colonsim.files import write_json
 from colonsim.provenance import code_version
+from colonsim.insertion.case.insertion_case import InsertionCase
+from colonsim.insertion.case.outcomes import RINGING_LIMIT
 from colonsim.insertion.study.claims import evaluate_claims
 
 import validation_checks as checks
 import validation_figures as figures
 import validation_sections as sections
+import validation_smoothness as smoothness
 from validation_markdown import write_markdown
 from validation_readings import add_readings
 from validation_sweeps import paired, read_sweep
@@ -149,6 +152,11 @@ def main(argv=None):
                              "(default colonsim_results/sweep_thesis)")
     parser.add_argument("--validation-sweep", type=Path, default=None,
                         help="validation sweep folder (the validation preset); its sections say NOT RUN without it")
+    for name, what in (("smoothness", "the smoothness sweep (benchmarks/sweeps/smoothness.toml)"),
+                       ("gp-train", "the surrogate's training sweep (benchmarks/sweeps/gp_train.toml)"),
+                       ("gp-test", "the surrogate's held-out sweep (benchmarks/sweeps/gp_test.toml)")):
+        parser.add_argument(f"--{name}-sweep", type=Path, default=None,
+                            help=f"folder of {what}; section 9 says NOT RUN without it")
     parser.add_argument("--out", type=Path, default=Path("docs/validation"), help="output folder (default docs/validation)")
     parser.add_argument("--size", choices=("reduced", "full"), default="reduced",
                         help="verification at the CI test sizes and quick calibration budget, or at full size")
@@ -158,6 +166,8 @@ def main(argv=None):
     try:
         main_sweep = read_sweep("main", args.sweep)
         validation = read_sweep("validation", args.validation_sweep, preset="validation")
+        smooth, gp_train, gp_test = (read_sweep(label, folder, optional=True) for label, folder in (
+            ("smoothness", args.smoothness_sweep), ("gp_train", args.gp_train_sweep), ("gp_test", args.gp_test_sweep)))
     except ColonsimError as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 2
@@ -187,8 +197,15 @@ def main(argv=None):
     doc = {"header": header(args, started, main_sweep, validation), "verification": verification,
            "calibration": calibration, "rsj": {"rows": rsj_rows, "checks": sections.rsj_checks(rsj_rows)},
            "claims": claims, "flexure_models": flexure_models(main_sweep, out),
+           "ringing": {"limit": RINGING_LIMIT, "sweeps": {"main": sections.ringing_rows(main_sweep),
+                                                          "validation": sections.ringing_rows(validation)}},
            "mesh_pair": pair_section(validation, main_sweep, "mesh"),
-           "rate_check": pair_section(validation, main_sweep, "rate"), "flexure_sensitivity": sensitivity,
+           "rate_check": {**pair_section(validation, main_sweep, "rate"),
+                          "speeds": (InsertionCase().push_speed, 0.5 * InsertionCase().push_speed)},
+           "smoothness": {"cubic": smoothness.cubic_departures(smooth, out / "figures" / "smoothness.png"),
+                          "figure": "figures/smoothness.png",
+                          "surrogate": smoothness.surrogate_holdout(gp_train, gp_test)},
+           "flexure_sensitivity": sensitivity,
            "node_counts": sections.node_counts(),
            "run_ends": {"main": sections.run_ends(main_sweep), "validation": sections.run_ends(validation)},
            "run_times": {"rows": times, "summary": sections.run_time_summary(times)}, "figures": figs}

@@ -12,6 +12,7 @@ from functools import lru_cache
 import numpy as np
 import pandas as pd
 
+from colonsim.insertion.case.outcomes import DEFORMATION_TOLERANCE, FORCE_FLOOR_N, FORCE_TOLERANCE, RINGING_LIMIT
 from colonsim.insertion.study.claims import NO_DEFORMATION_CM, advantage
 from colonsim.insertion.anatomy.colon_segments import colon_geometry
 from colonsim.insertion.study.reference import SOURCE_MESHES, SOURCE_RSJ_CM, SOURCE_RUN_MINUTES
@@ -25,10 +26,14 @@ SOURCE_NODES = {key: nodes for key, (nodes, _) in SOURCE_MESHES.items()}
 NODE_COUNT_MODELS = (("rsj", 23.0, 0.0), ("rsj", 36.0, 0.0), ("rsf", 36.0, 0.0), ("rsf", 36.0, 30.0),
                      ("rsf", 36.0, 45.0), ("thf", 36.0, 0.0), ("thf", 36.0, 30.0), ("thf", 36.0, 45.0),
                      ("thf-fixed", 36.0, 0.0))
-# What a mesh pair or a rate check compares, and the size below which a relative change says nothing.
-PAIR_QUANTITIES = (("final_deformation_cm", "final"), ("max_deformation_cm", "max"), ("point_A_cm", "A"),
-                   ("point_C_cm", "C"))
-PAIR_TOLERANCE = 0.05
+# What a mesh pair or a rate check compares: (column, name, the size below which a relative change
+# says nothing, the tolerance on the change).
+PAIR_QUANTITIES = (("final_deformation_cm", "final", NO_DEFORMATION_CM, DEFORMATION_TOLERANCE),
+                   ("max_deformation_cm", "max", NO_DEFORMATION_CM, DEFORMATION_TOLERANCE),
+                   ("point_A_cm", "A", NO_DEFORMATION_CM, DEFORMATION_TOLERANCE),
+                   ("point_C_cm", "C", NO_DEFORMATION_CM, DEFORMATION_TOLERANCE),
+                   ("peak_contact_force_N", "peak contact", FORCE_FLOOR_N, FORCE_TOLERANCE),
+                   ("peak_push_force_N", "peak push", FORCE_FLOOR_N, FORCE_TOLERANCE))
 FLEXURE_SCOPES = ("utc", "sdc")
 
 
@@ -125,8 +130,7 @@ def rsj_comparison(main):
             out.update({**facts, "A_source_over_ours": _ratio(src["A"], a), "C_source_over_ours": _ratio(src["C"], c),
                         "final_source_over_ours": _ratio(src["C"], final),
                         "C_gt_A": bool(np.isfinite(a) and np.isfinite(c) and c > a),
-                        "quasi_static": _flag(row["quasi_static"]),
-                        "quasi_static_literal": _flag(row["quasi_static_literal"])})
+                        "quasi_static": _flag(row["quasi_static"]), "ringing_ratio": _number(row, "ringing_ratio")})
             if ts is not None:
                 curves.append({"diameter_mm": d, "scope_role": scope, "depth_cm": ts["depth_cm"].to_numpy(),
                                "deformation_cm": ts["deformation_cm"].to_numpy(), "points": points,
@@ -198,7 +202,8 @@ def public(rows):
 
 def pair_rows(validation, main, check):
     """The ``check`` ("mesh" or "rate") pairs: base and variant value of each quantity, their
-    relative change and a pass / fail against :data:`PAIR_TOLERANCE`."""
+    relative change and a pass / fail against its tolerance (:data:`PAIR_QUANTITIES`), and the
+    ringing ratio of both runs."""
     rows = []
     for kind, changed, variant, base in paired(validation, main):
         if kind != check:
@@ -211,16 +216,17 @@ def pair_rows(validation, main, check):
                "quantities": [], "passed": None}
         if vrow is not None and brow is not None:
             judged = []
-            for column, name in PAIR_QUANTITIES:
-                if name in "AC" and variant.segment != "rsj":
+            for column, name, floor, tolerance in PAIR_QUANTITIES:
+                if name in ("A", "C") and variant.segment != "rsj":
                     continue  # the characteristic points are the RSJ's reading of its curve
                 b, v = _number(brow, column), _number(vrow, column)
-                change = relative_change(b, v, NO_DEFORMATION_CM)
-                ok = None if not np.isfinite(change) else bool(abs(change) < PAIR_TOLERANCE)
-                out["quantities"].append({"quantity": name, "base_cm": b, "variant_cm": v, "change": change,
-                                          "passed": ok})
+                change = relative_change(b, v, floor)
+                ok = None if not np.isfinite(change) else bool(abs(change) < tolerance)
+                out["quantities"].append({"quantity": name, "base": b, "variant": v, "change": change,
+                                          "tolerance": tolerance, "passed": ok})
                 judged += [ok] if ok is not None else []
             out["ended_by"] = [brow["ended_by"], vrow["ended_by"]]
+            out["ringing_ratio"] = [_number(brow, "ringing_ratio"), _number(vrow, "ringing_ratio")]
             out["passed"] = all(judged) if judged else None
         rows.append(out)
     return rows
@@ -257,6 +263,30 @@ def flexure_sensitivity(validation, main):
                             else None)
         rows.append(out)
     return rows
+
+
+# --- ringing ratio ----------------------------------------------------------------------------------
+
+def ringing_rows(sweep) -> dict:
+    """The ringing ratio of every run of ``sweep`` (docs/model.md, "Time integration and damping")."""
+    if not sweep.ran:
+        return {"ran": False}
+    rows = []
+    for case in sweep.cases:
+        row, status = sweep.run(case)
+        if row is None:
+            continue
+        summary = sweep.summary(row) or {}
+        qs = summary.get("quasi_static") or {}
+        rows.append({**_run_fields(case, row, status), "ringing_ratio": _number(row, "ringing_ratio"),
+                     "rms_N": qs.get("push_force_rms_N"), "mean_N": qs.get("mean_push_force_N"),
+                     "quasi_static": _flag(row.get("quasi_static"))})
+    ratios = [r["ringing_ratio"] for r in rows if r["ringing_ratio"] is not None and np.isfinite(r["ringing_ratio"])]
+    worst = max(rows, key=lambda r: r["ringing_ratio"] if np.isfinite(r["ringing_ratio"]) else -1.0, default=None)
+    return {"ran": True, "runs": len(rows), "passed": sum(r < RINGING_LIMIT for r in ratios),
+            "largest": max(ratios, default=math.nan), "median": float(np.median(ratios)) if ratios else math.nan,
+            "largest_run": f"{worst['segment'].upper()} {worst['scope']} {worst['inputs']}" if worst else "-",
+            "rows": rows}
 
 
 # --- meshes, run ends, run times ---------------------------------------------------------------------

@@ -97,11 +97,14 @@ def _row_case(row) -> InsertionCase:
     return InsertionCase(**values)
 
 
-def read_sweep(label, folder, preset=None) -> Sweep:
+def read_sweep(label, folder, preset=None, optional=False) -> Sweep:
     """The sweep in ``folder``. Without a results table there, the report's optional sweeps
-    (``preset`` given) come back empty, defined by the preset; the main sweep is an error."""
+    (``preset`` given: defined by the preset; ``optional``: with no runs) come back empty; the
+    main sweep is an error."""
     folder = None if folder is None else Path(folder)
     has_table = folder is not None and (folder / TABLE).is_file()
+    if not has_table and optional:
+        return Sweep(label, folder, [], pd.DataFrame(columns=["key", "status"]), False)
     if not has_table:
         if preset is None:
             raise ColonsimError(f"no {TABLE} in {folder}; run `colonsim sweep --preset thesis --out {folder}` first "

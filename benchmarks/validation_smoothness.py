@@ -1,0 +1,108 @@
+"""Smooth across inputs (docs/model.md, "Time integration and damping"): the validation report's
+section on how smoothly the insertion's outputs follow its inputs.
+
+Two checks, each reading sweeps made with the project's own tools:
+
+- **against scope diameter**: RSJ D36 mu 0 at scope diameters 9.0 to 13.5 mm in 0.5 mm steps
+  (``benchmarks/sweeps/smoothness.toml``); each output's departure from the least-squares cubic
+  in the diameter, largest over the runs, as a share of the output's range. Pass under 2 %.
+- **a surrogate's held-out error**: the project's GP surrogate fitted on a 20-run Latin hypercube
+  of RSJ (scope 9-13.5 mm, D 20-40 mm, mu 0-0.1; ``gp_train.toml``) predicts 30 independent runs
+  in the same ranges (``gp_test.toml``); its RMSE as a share of the held-out output's standard
+  deviation. Pass under 5 %.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from matplotlib.figure import Figure
+
+from colonsim.files import save_figure
+from colonsim.insertion.study.claims import NO_DEFORMATION_CM
+from colonsim.insertion.anatomy.scopes import colonoscope
+
+CUBIC_TOLERANCE = 0.02  # of the output's range
+SURROGATE_TOLERANCE = 0.05  # of the held-out output's spread
+CUBIC_OUTPUTS = (("final_deformation_cm", "final [cm]"), ("max_deformation_cm", "max [cm]"),
+                 ("point_C_cm", "C [cm]"), ("point_A_cm", "A [cm]"))
+SURROGATE_OUTPUTS = ("final_deformation_cm", "max_deformation_cm", "point_A_cm", "point_C_cm", "peak_contact_force_N",
+                     "peak_push_force_N")
+
+
+def _ok(table):
+    return table[table["status"] == "ok"] if "status" in table else table
+
+
+def cubic_departures(sweep, figure_path):
+    """Each output's largest departure from its cubic fit in the scope diameter, over its range."""
+    if not sweep.ran:
+        return {"ran": False}
+    runs = _ok(sweep.table)
+    d = np.array([colonoscope(s).diameter * 1e3 for s in runs["scope"]])
+    order = np.argsort(d)
+    d = d[order]
+    rows, curves = [], []
+    for column, label in CUBIC_OUTPUTS:
+        y = runs[column].to_numpy(dtype=float)[order]
+        keep = np.isfinite(y)
+        if keep.sum() < 5:
+            rows.append({"output": label, "runs": int(keep.sum()), "departure": math.nan, "passed": None})
+            continue
+        coef = np.polyfit(d[keep], y[keep], 3)
+        fit = np.polyval(coef, d[keep])
+        spread = float(np.ptp(y[keep]))
+        # an output that stays below 0.1 cm everywhere has no range to judge against (nothing
+        # measurable, as in the claims: insertion/study/claims.py NO_DEFORMATION_CM)
+        judged = float(np.abs(y[keep]).max()) >= NO_DEFORMATION_CM and spread > 0
+        departure = float(np.max(np.abs(y[keep] - fit)) / spread) if judged else math.nan
+        worst = float(d[keep][np.argmax(np.abs(y[keep] - fit))])
+        rows.append({"output": label, "runs": int(keep.sum()), "range": spread, "departure": departure,
+                     "at_scope_mm": worst if judged else None,
+                     "passed": bool(departure < CUBIC_TOLERANCE) if judged else None})
+        curves.append((label, d[keep], y[keep], coef))
+    _cubic_figure(curves, figure_path)
+    return {"ran": True, "rows": rows, "tolerance": CUBIC_TOLERANCE}
+
+
+def _cubic_figure(curves, path):
+    fig = Figure(figsize=(4.0 * max(len(curves), 1), 3.4))
+    axes = np.atleast_1d(fig.subplots(1, max(len(curves), 1)))
+    for ax, (label, d, y, coef) in zip(axes, curves):
+        fine = np.linspace(d.min(), d.max(), 200)
+        ax.plot(d, y, "o", label="runs")
+        ax.plot(fine, np.polyval(coef, fine), "-", lw=1, label="cubic fit")
+        ax.set_xlabel("scope diameter [mm]")
+        ax.set_ylabel(label)
+    axes[0].legend(fontsize=8)
+    fig.suptitle("RSJ D36, mu 0: outputs against scope diameter", fontsize=10)
+    fig.tight_layout()
+    save_figure(fig, path)
+
+
+def surrogate_holdout(train, test):
+    """The project's surrogate fitted on ``train`` predicting ``test``: RMSE over the held-out
+    spread, and the calibration of its 95 % intervals, per output."""
+    if not (train.ran and test.ran):
+        return {"ran": False}
+    from colonsim.surrogate.model import SweepSurrogate
+
+    train_runs, test_runs = _ok(train.table), _ok(test.table)
+    targets = [t for t in SURROGATE_OUTPUTS if t in train_runs and train_runs[t].notna().sum() >= 4]
+    model = SweepSurrogate(targets=targets).fit(train_runs)
+    rows = []
+    for target in targets:
+        truth = test_runs[target].to_numpy(dtype=float)
+        frame = model.predict_frame(test_runs, targets=[target], segment="rsj")
+        mean, sd = frame[target].to_numpy(dtype=float), frame[f"{target}_std"].to_numpy(dtype=float)
+        keep = np.isfinite(truth) & np.isfinite(mean)
+        err = mean[keep] - truth[keep]
+        rmse = float(np.sqrt(np.mean(err**2)))
+        spread = float(np.std(truth[keep]))
+        share = rmse / spread if spread > 0 else math.nan
+        covered = float(np.mean(np.abs(err) <= 1.96 * sd[keep])) if keep.any() else math.nan
+        rows.append({"output": target, "train_runs": int(train_runs[target].notna().sum()), "test_runs": int(keep.sum()),
+                     "rmse": rmse, "spread": spread, "share": share, "coverage95": covered,
+                     "passed": bool(share < SURROGATE_TOLERANCE) if np.isfinite(share) else None})
+    return {"ran": True, "rows": rows, "tolerance": SURROGATE_TOLERANCE}
