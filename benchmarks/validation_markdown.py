@@ -7,6 +7,7 @@ import math
 from colonsim.files import atomic_path
 from colonsim.insertion.study.verification_rules import GROUPS
 from colonsim.markdown import md_table, num
+from validation_resistance import markdown as resistance_markdown
 
 NOT_RUN = "**NOT RUN**"
 
@@ -385,6 +386,7 @@ def write_markdown(doc, path):
              + mesh_pair(doc["mesh_pair"])
              + rate_check(doc["rate_check"]) + smoothness(doc["smoothness"])
              + flexure_sensitivity(doc["flexure_sensitivity"])
-             + node_counts(doc["node_counts"]) + run_ends(doc["run_ends"]) + run_times(doc["run_times"]))
+             + node_counts(doc["node_counts"]) + run_ends(doc["run_ends"]) + run_times(doc["run_times"])
+             + resistance_markdown(doc["resistance"]))
     with atomic_path(path) as tmp:
         tmp.write_text("\n".join(lines), encoding="utf-8")

@@ -43,6 +43,7 @@ from colonsim.insertion.study.claims import evaluate_claims
 import validation_checks as checks
 import validation_figures as figures
 import validation_sections as sections
+import validation_resistance as resistance
 import validation_smoothness as smoothness
 from validation_markdown import write_markdown
 from validation_readings import add_readings
@@ -154,9 +155,10 @@ def main(argv=None):
                         help="validation sweep folder (the validation preset); its sections say NOT RUN without it")
     for name, what in (("smoothness", "the smoothness sweep (benchmarks/sweeps/smoothness.toml)"),
                        ("gp-train", "the surrogate's training sweep (benchmarks/sweeps/gp_train.toml)"),
-                       ("gp-test", "the surrogate's held-out sweep (benchmarks/sweeps/gp_test.toml)")):
+                       ("gp-test", "the surrogate's held-out sweep (benchmarks/sweeps/gp_test.toml)"),
+                       ("resistance", "the distal resistance sweep (colonsim sweep --preset resistance)")):
         parser.add_argument(f"--{name}-sweep", type=Path, default=None,
-                            help=f"folder of {what}; section 9 says NOT RUN without it")
+                            help=f"folder of {what}; its section says NOT RUN without it")
     parser.add_argument("--out", type=Path, default=Path("docs/validation"), help="output folder (default docs/validation)")
     parser.add_argument("--size", choices=("reduced", "full"), default="reduced",
                         help="verification at the CI test sizes and quick calibration budget, or at full size")
@@ -166,8 +168,9 @@ def main(argv=None):
     try:
         main_sweep = read_sweep("main", args.sweep)
         validation = read_sweep("validation", args.validation_sweep, preset="validation")
-        smooth, gp_train, gp_test = (read_sweep(label, folder, optional=True) for label, folder in (
-            ("smoothness", args.smoothness_sweep), ("gp_train", args.gp_train_sweep), ("gp_test", args.gp_test_sweep)))
+        smooth, gp_train, gp_test, resisted = (read_sweep(label, folder, optional=True) for label, folder in (
+            ("smoothness", args.smoothness_sweep), ("gp_train", args.gp_train_sweep), ("gp_test", args.gp_test_sweep),
+            ("resistance", args.resistance_sweep)))
     except ColonsimError as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 2
@@ -206,6 +209,7 @@ def main(argv=None):
                           "figure": "figures/smoothness.png",
                           "surrogate": smoothness.surrogate_holdout(gp_train, gp_test)},
            "flexure_sensitivity": sensitivity,
+           "resistance": resistance.resistance_section(resisted),
            "node_counts": sections.node_counts(),
            "run_ends": {"main": sections.run_ends(main_sweep), "validation": sections.run_ends(validation)},
            "run_times": {"rows": times, "summary": sections.run_time_summary(times)}, "figures": figs}

@@ -68,6 +68,9 @@ class ColonModel:
     reads_centerline : bool
         The geometry is a user's centerline CSV (``InsertionCase.centerline``); the builder then
         also takes ``centerline=`` (a loaded centerline).
+    exit_takes_length : bool
+        The fixed exit is lengthened to take the whole available scope length (the tip, held back
+        by the distal resistance, never reaches its far end; docs/model.md, "Loading").
     """
 
     name: str
@@ -81,6 +84,7 @@ class ColonModel:
     end_rule: str = FAR_END
     surrogate_angle: bool = False
     reads_centerline: bool = False
+    exit_takes_length: bool = False
 
     def __post_init__(self):
         def bad(what):
@@ -132,12 +136,13 @@ COLON_MODELS = {m.name: m for m in (
                f"{_BUILDERS}:rsj_geometry", 0.30, mobile_piece="sigmoid", end_rule=PAST_MOBILE_END),
     ColonModel("rsf", "rectum to splenic flexure, the sigmoid tilted by alpha",
                f"{_BUILDERS}:rsf_geometry", 0.70, ALPHA, ANGLE_LIMITS_DEG, STRAIGHTEN_RELAX_PUSH, "sigmoid",
-               FAR_END_OR_LENGTH, surrogate_angle=True),
+               FAR_END_OR_LENGTH, surrogate_angle=True, exit_takes_length=True),
     ColonModel("thf", "transverse colon as a V of angle beta, hepatic flexure",
                f"{_BUILDERS}:thf_geometry", 0.50, BETA, ANGLE_LIMITS_DEG, STRAIGHTEN_RELAX_PUSH, "transverse",
-               FAR_END_OR_LENGTH, surrogate_angle=True),
+               FAR_END_OR_LENGTH, surrogate_angle=True, exit_takes_length=True),
     ColonModel("thf-fixed", "thf with the transverse colon fixed",
-               f"{_BUILDERS}:thf_fixed_geometry", 0.50, BETA, ANGLE_LIMITS_DEG, end_rule=FAR_END_OR_LENGTH),
+               f"{_BUILDERS}:thf_fixed_geometry", 0.50, BETA, ANGLE_LIMITS_DEG, end_rule=FAR_END_OR_LENGTH,
+               exit_takes_length=True),
     ColonModel("straight", "a 20 cm straight tube, a sanity case",
                f"{_BUILDERS}:straight_geometry", 0.30),
     # a continuous push: the straighten-relax-push blocks lateral motion along straight mobile
@@ -353,7 +358,12 @@ COLUMNS = {c.name: c for c in (
     Column("stop_distance_mm", _S, "mm", "push over which the scope slows to rest at the end of the run"),
     Column("settle_s", _S, "s", "time the scope is held still at the end before the final values are read"),
     Column("settle_lateral_damping", _S, "1/s", "lateral damping of the scope while it settles at rest"),
-    Column("exit_length_mm", _S, "mm", "fixed colon after the last mobile piece"),
+    Column("exit_length_mm", _S, "mm", "fixed colon after the last mobile piece (a minimum where the exit takes the "
+                                       "whole available length: RSF, THF, fixed THF)"),
+    Column("distal_resistance_N", _I, "N", "force the colon beyond the model opposes to the tip's advance once it is in "
+                                           "the fixed exit (docs/model.md, \"Loading\")", SURROGATE_INPUT,
+           "distal resistance [N]", "--distal-resistance"),
+    Column("failure_stretch", _S, "", "wall stretch at which a run ends (ended_by wall_stretch)"),
     Column("sheath_reserve_mm", _S, "mm", "scope length kept in the sheath"),
     Column("colon_damping", _S, "1/s", "mass-proportional damping of the colon"),
     Column("scope_damping", _S, "1/s", "mass-proportional damping of the scope"),
@@ -382,7 +392,10 @@ COLUMNS = {c.name: c for c in (
     Column("quasi_static", _O, "", "the ringing ratio is below 0.1: the push force follows the push without ringing"),
     Column("kinetic_energy_check", _O, "", "kinetic / internal energy below 10 % on most samples for both bodies, the "
                                            "scope's imposed sliding set aside (information: it passed runs that rang)"),
-    Column("ended_by", _O, "", "why the run ended: tip_past_end, far_end, length_used or jam "
+    Column("max_lag_cm", _O, "cm", "largest lag of the scope: pushed depth minus the tip's advance along the "
+                                   "centerline (a proxy of the buckled length)", TARGET, "maximum scope lag [cm]"),
+    Column("final_lag_cm", _O, "cm", "the scope's lag at the end of the run", TARGET, "final scope lag [cm]"),
+    Column("ended_by", _O, "", "why the run ended: tip_past_end, far_end, length_used, wall_stretch or jam "
                                "(docs/model.md, \"Loading\")"),
     Column("end_depth_cm", _O, "cm", "pushed depth where the run ended"),
     Column("end_push_force_N", _O, "N", "push force where the run ended"),

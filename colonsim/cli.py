@@ -112,6 +112,9 @@ def _add_insert(sub):
                    help="turn of the splenic (RSF) or hepatic (THF) flexure, degrees (default 90, an assumption)")
     p.add_argument("--exit-length", type=finite_float, default=100.0,
                    help="mm of fixed colon after the last mobile piece (default 100, an assumption)")
+    p.add_argument("--distal-resistance", type=finite_float, default=5.0,
+                   help="N the colon beyond the model opposes to the tip's advance once it is in the fixed exit "
+                        "(default 5, the light level of 0/5/10/20; 0: none; docs/model.md, \"Loading\")")
     p.add_argument("--vtu", action="store_true", help="write deformed meshes for ParaView (needs meshio)")
     p.add_argument("--snapshot-every", type=finite_float, default=0.02, help="simulated seconds between VTU snapshots")
     p.add_argument("--threads", type=int, default=None,
@@ -142,7 +145,8 @@ def cmd_insert(args):
                            flexure_angle_deg=args.flexure_angle, friction=args.friction,
                            wall_thickness_mm=args.wall_thickness,
                            element_size_mm=args.element_size, material=args.material,
-                           exit_length_mm=args.exit_length) for scope in args.scope]
+                           exit_length_mm=args.exit_length, distal_resistance_N=args.distal_resistance)
+             for scope in args.scope]
     if args.material is not None:
         from colonsim.insertion.engine.material import load_material
 

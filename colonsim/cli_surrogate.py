@@ -18,10 +18,10 @@ from colonsim.options import finite_float, output_file
 # command-line option -> results-table column
 RAW_OPTIONS = {"scope_diameter": "scope_diameter_mm", "diameter": "diameter_mm", "angle": "angle_deg",
                "friction": "friction", "wall_thickness": "wall_thickness_mm", "wall_mu0": catalog.WALL_MU0,
-               "wall_c11": catalog.WALL_C11}
+               "wall_c11": catalog.WALL_C11, "distal_resistance": "distal_resistance_N"}
 VS_NAMES = {"scope": "scope_diameter_mm", "scope-diameter": "scope_diameter_mm", "diameter": "diameter_mm",
             "angle": "angle_deg", "friction": "friction", "wall-thickness": "wall_thickness_mm",
-            "wall-mu0": catalog.WALL_MU0, "wall-c11": catalog.WALL_C11}
+            "wall-mu0": catalog.WALL_MU0, "wall-c11": catalog.WALL_C11, "distal-resistance": "distal_resistance_N"}
 MATERIAL_HELP = ("calibration file of the tissue distribution predictions average over: a material.json (its "
                  "posterior) or a population.json (its specimens); default: the one the sweep sampled")
 
@@ -52,6 +52,8 @@ def _patient_options(p, scope_diameter=True):
     g.add_argument("--angle", type=finite_float, help=f"degrees: {catalog.angle_help()}")
     g.add_argument("--friction", type=finite_float, help="Coulomb friction scope/wall")
     g.add_argument("--wall-thickness", type=finite_float, help="colon wall thickness, mm")
+    g.add_argument("--distal-resistance", type=finite_float,
+                   help="force the colon beyond the model opposes to the tip, N (docs/model.md, \"Loading\")")
     g.add_argument("--wall-mu0", type=finite_float, help="a known wall's small-strain shear modulus, kPa (with --wall-c11)")
     g.add_argument("--wall-c11", type=finite_float, help="a known wall's C11, kPa (without both: averaged over the tissue)")
     g.add_argument("--material", type=Path, help=MATERIAL_HELP)

@@ -20,7 +20,8 @@ def add_parser(sub):
                                    "into the same --out skips the runs already finished.")
     p.add_argument("spec", nargs="?", type=Path, help="sweep TOML file")
     p.add_argument("--preset", help="thesis (the source's 39 insertions), validation (the validation report's "
-                                    "24 extra runs) or smoke (3 fast runs)")
+                                    "24 extra runs), resistance (the distal resistance study, 136 runs) or smoke "
+                                    "(3 fast runs)")
     p.add_argument("--workers", type=positive_int, default=None,
                    help=f"local worker processes, one Numba thread each (default: the cores, {available_cores()} here)")
     p.add_argument("--scheduler", metavar="ADDR",

@@ -289,7 +289,8 @@ def insert(cases, out: Path, vtu=False, snapshot_every=0.02, show=True, max_step
     from tqdm import tqdm
 
     from colonsim.files import save_figure, write_csv
-    from colonsim.insertion.case.results import comparison_table, insertion_figure, quasi_static_words, write_insertion
+    from colonsim.insertion.case.results import (comparison_table, distal_words, insertion_figure, quasi_static_words,
+                                              write_insertion)
     from colonsim.insertion.case.run_budget import check_run_budget
     from colonsim.insertion.case.scenario import run_insertion
 
@@ -317,7 +318,7 @@ def insert(cases, out: Path, vtu=False, snapshot_every=0.02, show=True, max_step
         pts = ", ".join(f"{k} {v['deformation_cm']:.2f} cm" for k, v in s["points_cm"].items() if v is not None)
         print(f"{case.segment.upper()} {s['scope']['name']:>8}: final deformation {s['final_deformation_cm']:.2f} cm, "
               f"max {s['max_deformation_cm']:.2f} cm ({pts}); peak contact {s['peak_contact_force_N']:.2f} N, "
-              f"peak push {s['peak_push_force_N']:.2f} N; {quasi_static_words(s['quasi_static'])}; "
+              f"peak push {s['peak_push_force_N']:.2f} N; {distal_words(s)}; {quasi_static_words(s['quasi_static'])}; "
               f"ended: {s['end']['reason']} at {s['end']['depth_cm']:.1f} cm; "
               f"{s['steps']} steps in {s['wall_time_s']:.1f} s -> {folder}/")
     table, figure = comparison_table(results), insertion_figure(results)  # both made before either file is replaced

@@ -42,7 +42,7 @@ from colonsim.insertion.anatomy.colon_centerlines import (EXIT_LENGTH, FLEXURE_A
 from colonsim.insertion.anatomy.colon_geometry import tube_mesh
 from colonsim.insertion.engine.sheet_mesh import straight_tube
 
-EXIT_LIMIT = 0.3  # m, fixed exit piece
+EXIT_LIMIT = 0.4  # m, fixed exit piece (RSF takes about 31 cm for its available length)
 STRAIGHT_LENGTH = 0.20  # m, the straight sanity tube
 
 
@@ -67,6 +67,9 @@ class ColonGeometry:
     end_depth: float | None = None
     # arc length where the mobile part ends (None: no mobile part)
     mobile_end: float | None = None
+    # arc length where the fixed exit begins: the last piece, when it is fixed and follows another
+    # (the plane past which the distal resistance holds the tip back; None: no exit)
+    exit_start: float | None = None
     # the wall's tube mesh with its centerline (None for the straight tube)
     tube: object = None
     # lumen diameter (min, median, max), m, of a diameter profile (None: constant diameter)
@@ -81,6 +84,7 @@ class ColonGeometry:
                 "fixed_nodes": int(self.fixed.sum()), "mobile_nodes": int(self.mobile.sum()),
                 "end_ring_nodes": int(self.end_ring.sum()), "centerline_length_cm": self.centerline_length * 100,
                 "mobile_end_cm": None if self.mobile_end is None else self.mobile_end * 100,
+                "exit_start_cm": None if self.exit_start is None else self.exit_start * 100,
                 **({} if self.lumen_diameters is None else
                    {"lumen_diameter_mm": dict(zip(("min", "median", "max"), (d * 1e3 for d in self.lumen_diameters)))})}
 
@@ -120,6 +124,14 @@ def mobile_end(centerline):
     return float(ends[-1]) if ends else None
 
 
+def exit_start(centerline):
+    """Arc length where the fixed exit begins, m: the start of the last piece when it is fixed and
+    is not the only piece (None otherwise)."""
+    if len(centerline.pieces) < 2 or centerline.pieces[-1].tag != "fixed":
+        return None
+    return float(centerline.s_start[-1])
+
+
 def _tube_geometry(centerline, diameter, element_size, wall_thickness) -> ColonGeometry:
     """The wall of ``centerline`` meshed at its mid-surface, with the mesh kept for the catalog's rules.
 
@@ -137,7 +149,7 @@ def _tube_geometry(centerline, diameter, element_size, wall_thickness) -> ColonG
                          entry_point=centerline.position(0.0), entry_axis=centerline.tangent(0.0),
                          centerline_length=centerline.length,
                          centerline_points=lambda s: centerline.position(np.atleast_1d(s)),
-                         mobile_end=mobile_end(centerline), tube=mesh)
+                         mobile_end=mobile_end(centerline), exit_start=exit_start(centerline), tube=mesh)
 
 
 def straight_colon(length, diameter, element_size, wall_thickness, fixed_length=0.0) -> ColonGeometry:

@@ -14,13 +14,15 @@ from dataclasses import asdict, dataclass
 from colonsim.catalog import colon_model
 from colonsim.errors import ColonsimError
 from colonsim.insertion.anatomy.centerline_file import load_centerline_points
-from colonsim.insertion.anatomy.colon_segments import check_patient_tube
+from colonsim.insertion.anatomy.colon_segments import EXIT_LIMIT, check_patient_tube
 from colonsim.insertion.anatomy.patient_centerline import SMOOTHING_MM, load_patient_centerline
 from colonsim.insertion.anatomy.scopes import colonoscope
 from colonsim.insertion.case.case_material import case_material
 
 # cases that do not use them stay what they were (existing sweep folders resume).
-LATER_FIELDS = ("centerline", "centerline_smoothing_mm", "material_parameters")
+LATER_FIELDS = ("centerline", "centerline_smoothing_mm", "material_parameters", "failure_stretch")
+# fields left out of the key at the value that gives the runs of before they existed
+ABSENT_AT = {"distal_resistance_N": 0.0}
 
 
 @dataclass
@@ -48,6 +50,16 @@ class InsertionCase:
         Turn of the splenic (RSF) or hepatic (THF) flexure (**assumption** 90).
     exit_length_mm : float
         Fixed colon after the last mobile piece (**assumption** 100; for THF the ascending colon).
+        For the models whose exit takes the whole available length (RSF, THF, fixed THF:
+        ``exit_takes_length`` in the catalog) it is a minimum: the exit is lengthened so the tip
+        never reaches its far end.
+    distal_resistance_N : float
+        The force the colon beyond the model opposes to the tip's advance once the tip is in the
+        fixed exit, N (**assumption** 5, the light level of 0 / 5 / 10 / 20; 0: none; docs/model.md,
+        "Loading").
+    failure_stretch : float
+        The run ends when the wall's largest stretch passes it (``ended_by = "wall_stretch"``;
+        **assumption** 1.6, near the tissue's tearing).
     friction : float
         Coulomb coefficient mu between scope and wall.
     wall_thickness_mm : float
@@ -102,6 +114,8 @@ class InsertionCase:
     settle_s: float = 0.1
     settle_lateral_damping: float = 200.0
     exit_length_mm: float = 100.0
+    distal_resistance_N: float = 5.0
+    failure_stretch: float = 1.6
     sheath_reserve_mm: float = 20.0
     colon_damping: float = 120.0
     scope_damping: float = 0.0
@@ -137,7 +151,10 @@ class InsertionCase:
             ("time_step_factor", self.time_step_factor, 0.01, 1.0, "a safety factor in (0, 1]"),
             ("ramp_s", self.ramp_s, 0.0, 10.0, "ramp duration in s (0.4)"),
             ("relax_s", self.relax_s, 1e-3, 10.0, "relax duration in s (0.1 by default)"),
-            ("exit_length_mm", self.exit_length_mm, 0.0, 300.0, "fixed exit length in mm (100 by default)"),
+            ("exit_length_mm", self.exit_length_mm, 0.0, 1e3 * EXIT_LIMIT, "fixed exit length in mm (100 by default)"),
+            ("distal_resistance_N", self.distal_resistance_N, 0.0, 100.0,
+             "distal resistance in N (5 by default; 0, 5, 10, 20 are the study's levels)"),
+            ("failure_stretch", self.failure_stretch, 1.01, 10.0, "wall stretch at which a run ends (1.6)"),
             ("flexure_angle_deg", self.flexure_angle_deg, 1.0, 180.0, "flexure turn in degrees (90 by default)"),
             ("sheath_reserve_mm", self.sheath_reserve_mm, 0.0, 200.0, "scope length kept in the sheath, mm (20)"),
         ]
@@ -185,6 +202,9 @@ class InsertionCase:
         defaults = InsertionCase()
         for name in LATER_FIELDS:
             if inputs[name] == getattr(defaults, name):
+                del inputs[name]
+        for name, value in ABSENT_AT.items():
+            if inputs[name] == value:
                 del inputs[name]
         if self.centerline is not None:
             inputs["centerline"] = "sha256:" + load_centerline_points(self.centerline).digest()

@@ -3,7 +3,10 @@
 Columns (SI): time_s, depth_m (pushed distance), deformation_m (largest nodal displacement of
 the mobile colon part), max_stretch (largest in-plane principal stretch of the wall), tip_displacement_m,
 tip_arc_m (tip position along the centerline, the closest centerline point), tip_past_end_m
-(signed distance of the tip past the end plane of the run: >= 0 once it has passed the fixed end), contact_force_N (sum of normal contact forces),
+(signed distance of the tip past the end plane of the run: >= 0 once it has passed the fixed end),
+lag_m (the scope's lag: pushed depth minus the tip's advance along the centerline), distal_force_N
+(the distal resistance holding the tip back, :mod:`colonsim.insertion.engine.tip_resistance`; 0
+without one), contact_force_N (sum of normal contact forces),
 push_force_N (drive reaction along the sheath axis), contact_nodes, kinetic/internal energy
 of each body (J), kinetic_scope_sliding_J (the scope's kinetic energy relative to sliding along
 itself at the push speed, :func:`colonsim.insertion.case.outcomes.sliding_kinetic_energy`), contact_energy_J, dt_s, step.
@@ -54,16 +57,20 @@ class InsertionRecorder:
         else:
             deformation = 0.0
         tip = scope.x[self._tip]
+        depth = m.push.depth(solver.time)
+        tip_arc = float(self._arc[np.argmin(((self._arc_points - tip) ** 2).sum(axis=1))])
         row = {
             "time_s": solver.time,
             "step": solver.step,
             "dt_s": solver.dt,
-            "depth_m": m.push.depth(solver.time),
+            "depth_m": depth,
             "deformation_m": deformation,
             "max_stretch": float(principal_stretches(colon.x, self._triangles, self._dm_inv).max()),
             "tip_displacement_m": float(np.linalg.norm(tip - self._tip0)),
-            "tip_arc_m": float(self._arc[np.argmin(((self._arc_points - tip) ** 2).sum(axis=1))]),
+            "tip_arc_m": tip_arc,
             "tip_past_end_m": float(np.dot(tip - self._end_point, self._end_axis)),
+            "lag_m": depth - tip_arc,
+            "distal_force_N": float(m.resistance.force) if m.resistance is not None else 0.0,
             "contact_force_N": float(m.contact.normal_force),
             "contact_nodes": int(m.contact.n_active),
             "push_force_N": float(np.dot(m.drive.reaction, m.entry_axis)),

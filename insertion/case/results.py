@@ -28,7 +28,8 @@ def user_units(ts: pd.DataFrame) -> pd.DataFrame:
     out = pd.DataFrame({"time_s": ts["time_s"], "phase": ts["phase"], "depth_cm": ts["depth_m"] * 100,
                         "deformation_cm": ts["deformation_m"] * 100, "max_wall_stretch": ts["max_stretch"],
                         "tip_displacement_cm": ts["tip_displacement_m"] * 100, "tip_arc_cm": ts["tip_arc_m"] * 100,
-                        "tip_past_end_cm": ts["tip_past_end_m"] * 100,
+                        "tip_past_end_cm": ts["tip_past_end_m"] * 100, "lag_cm": ts["lag_m"] * 100,
+                        "distal_force_N": ts["distal_force_N"],
                         "contact_force_N": ts["contact_force_N"], "push_force_N": ts["push_force_N"],
                         "contact_nodes": ts["contact_nodes"]})
     for col in ("kinetic_colon_J", "internal_colon_J", "kinetic_scope_J", "kinetic_scope_sliding_J", "internal_scope_J",
@@ -47,18 +48,28 @@ def quasi_static_words(qs: dict) -> str:
     return f"ringing ratio {ratio:.3f} (limit {RINGING_LIMIT:g}): quasi-static {verdict}"
 
 
+def distal_words(summary: dict) -> str:
+    """The distal resistance and the scope's lag of a summary, for the command line."""
+    d = summary["distal_resistance"]
+    lag = f"scope lag max {summary['max_lag_cm']:.1f} cm, final {summary['final_lag_cm']:.1f} cm"
+    if not d["acting"]:
+        return f"no distal resistance; {lag}"
+    return f"distal resistance {d['resistance_N']:g} N (holding {d['final_force_N']:.1f} N at the end); {lag}"
+
+
 def comparison_table(results) -> pd.DataFrame:
     """One row of scalar outcomes per run (cm, N), for comparing scopes or cases."""
     return pd.DataFrame([{"segment": r.case.segment, "scope": r.summary["scope"]["name"],
                            "scope_diameter_mm": r.summary["scope"]["diameter_mm"], "colon_diameter_mm": r.case.diameter_mm,
                            "angle_deg": r.case.angle_deg, "flexure_angle_deg": r.case.flexure_angle_deg,
-                           "friction": r.case.friction,
+                           "friction": r.case.friction, "distal_resistance_N": r.case.distal_resistance_N,
                            "final_deformation_cm": r.summary["final_deformation_cm"],
                            "max_deformation_cm": r.summary["max_deformation_cm"],
                            **{f"point_{k}_cm": (None if v is None else v["deformation_cm"]) for k, v in r.summary["points_cm"].items()},
                            "peak_contact_force_N": r.summary["peak_contact_force_N"],
                            "peak_push_force_N": r.summary["peak_push_force_N"],
                            "max_wall_stretch": r.summary["max_wall_stretch"],
+                           "max_lag_cm": r.summary["max_lag_cm"], "final_lag_cm": r.summary["final_lag_cm"],
                            "ringing_ratio": r.summary["quasi_static"]["ringing_ratio"],
                            "quasi_static": r.summary["quasi_static"]["holds"],
                            "ended_by": r.summary["ended_by"], "wall_time_s": r.summary["wall_time_s"]}
@@ -76,11 +87,14 @@ def insertion_figure(results) -> Figure:
         colour = line.get_color()
         axes[0, 1].plot(ts["time_s"], ts["contact_force_N"], c=colour, label=f"{label}: contact")
         axes[0, 1].plot(ts["time_s"], ts["push_force_N"], "--", c=colour, lw=0.6, alpha=0.6, label=f"{label}: push")
+        if ts["distal_force_N"].any():
+            axes[0, 1].plot(ts["time_s"], ts["distal_force_N"], ":", c=colour, label=f"{label}: distal resistance")
         for body, style in (("colon", "-"), ("scope", ":")):
             # the ratio is meaningless before the body stores strain energy (round-off level)
             internal = ts[f"internal_{body}_J"].where(ts[f"internal_{body}_J"] > 1e-9)
             axes[1, 0].plot(ts["time_s"], ts[f"kinetic_{body}_J"] / internal, style, c=colour, label=f"{label}: {body}")
-        axes[1, 1].plot(ts["time_s"], ts["tip_displacement_m"] * 100, c=colour, label=label)
+        axes[1, 1].plot(ts["time_s"], ts["tip_displacement_m"] * 100, c=colour, label=f"{label}: tip displacement")
+        axes[1, 1].plot(ts["time_s"], ts["lag_m"] * 100, "--", c=colour, label=f"{label}: scope lag")
         for name, p in r.summary["points_cm"].items():
             if p is not None:
                 axes[0, 0].annotate(name, (p["time_s"], p["deformation_cm"]), textcoords="offset points", xytext=(0, 6),
@@ -90,7 +104,7 @@ def insertion_figure(results) -> Figure:
     axes[1, 0].set_ylabel("kinetic / internal energy")
     axes[1, 0].axhline(0.1, c="0.5", lw=0.8)
     axes[1, 0].set_yscale("log")
-    axes[1, 1].set_ylabel("tip displacement [cm]")
+    axes[1, 1].set_ylabel("tip displacement, scope lag [cm]")
     for ax in axes.ravel():
         ax.set_xlabel("time [s]")
         ax.legend(fontsize=7)

@@ -15,6 +15,7 @@ ENDINGS = {
     "tip_past_end": "the tip passed the fixed end",
     "far_end": "the tip reached the model's far end",
     "length_used": "the scope's available length was pushed in",
+    "wall_stretch": "the wall's largest stretch passed the failure stretch",
     "jam": f"the tip jammed: under {JAM_PROGRESS * 1e3:g} mm of tip progress over {JAM_PUSH * 100:g} cm of push "
            "while the push force rose",
 }
@@ -90,6 +91,13 @@ def summarize(model, ts, wall_s, build_s) -> dict:
                                              f"over {PEAK_WINDOW * 1e3:g} mm of push"},
         "max_wall_stretch": float(ts["max_stretch"].max()),
         "final_tip_arc_cm": float(ts["tip_arc_m"].iloc[-1] * 100),
+        "max_lag_cm": float(ts["lag_m"].max() * 100),
+        "final_lag_cm": float(ts["lag_m"].iloc[-1] * 100),
+        "distal_resistance": {"resistance_N": model.case.distal_resistance_N,
+                              "exit_start_cm": None if g.exit_start is None else g.exit_start * 100,
+                              "acting": model.resistance is not None,
+                              "final_force_N": float(ts["distal_force_N"].iloc[-1]),
+                              "max_force_N": float(ts["distal_force_N"].max())},
         "quasi_static": quasi_static_summary(ts, qs, sliding),
         "simulated_time_s": float(ts["time_s"].iloc[-1]),
         "steps": int(model.solver.step),

@@ -12,6 +12,12 @@ Modelling choices (stated so they can be cited):
   that constraint's reaction; at most the scope length less ``sheath_reserve_mm`` is pushed in
   (the scope's available length);
 - fixed colon parts and the end rings are held (zero velocity); the mobile part is free;
+- once the tip is past the start of the fixed exit, the distal resistance holds it back
+  (:class:`colonsim.insertion.engine.tip_resistance.TipResistance`, ``distal_resistance_N``),
+  engaged over the first :data:`DISTAL_RAMP` of the exit (:func:`resistance_share`, set after
+  every chunk of push from the tip's position along the centerline), along the lumen's direction
+  at the tip, regularised at :data:`DISTAL_CREEP_SHARE` of the push speed; in the models whose exit takes
+  the whole available length, the exit is lengthened so the tip cannot reach its far end;
 - quasi-static runs use mass-proportional damping, by default 60 1/s on the colon (about
   critical for its lowest bending modes of ~10 Hz) and 5 1/s on the scope (its rigid push
   through the sheath would otherwise feel a drag of alpha m v);
@@ -20,9 +26,10 @@ Modelling choices (stated so they can be cited):
   model's end depth while lying within one diameter of it along the centerline
   (``"tip_past_end"``: for RSJ 2 cm past the sigmoid's fixed end; ``"far_end"``: for RSF/THF the
   far end of the fixed exit, beyond which the tip would leave the model), when the available
-  length is pushed in (``"length_used"``), or when the tip jams (``"jam"``,
-  :func:`colonsim.insertion.case.outcomes.jammed`). A jam is an outcome: the summary says where and under which
-  forces.
+  length is pushed in (``"length_used"``), when the wall's largest stretch passes
+  ``failure_stretch`` (``"wall_stretch"``), or when the tip jams (``"jam"``,
+  :func:`colonsim.insertion.case.outcomes.jammed`; a tip held back by the distal resistance is
+  not a jam). A jam or a torn wall is an outcome: the summary says where and under which forces.
 """
 
 from __future__ import annotations
@@ -35,7 +42,7 @@ import numpy as np
 
 from colonsim.catalog import CONTINUOUS_PUSH, colon_model
 from colonsim.errors import ColonsimError
-from colonsim.insertion.anatomy.colon_segments import colon_geometry
+from colonsim.insertion.anatomy.colon_segments import EXIT_LIMIT, colon_geometry
 from colonsim.insertion.anatomy.manoeuvre import SETTLE, PushProfile, continuous_push, straighten_relax_push
 from colonsim.insertion.anatomy.scopes import colonoscope
 from colonsim.insertion.case.case_material import case_material
@@ -47,10 +54,14 @@ from colonsim.insertion.engine.contact import RodShellContact
 from colonsim.insertion.engine.sheath_lip import SheathLip
 from colonsim.insertion.engine.shell import Shell
 from colonsim.insertion.engine.solver import ExplicitSolver
+from colonsim.insertion.engine.tip_resistance import TipResistance
 
 __all__ = ["COLON_DENSITY", "Insertion", "InsertionCase", "InsertionResult", "build_insertion", "run_insertion"]
 
 COLON_DENSITY = 1040.0  # kg/m^3
+DISTAL_RAMP = 0.01  # m of exit over which the distal resistance engages (assumption, docs/model.md "Loading")
+DISTAL_CREEP_SHARE = 0.01  # the resistance's regularisation speed, as a share of the push speed
+EXIT_MARGIN = 0.05  # m of exit left beyond the available length (the tip may cut the bends' corners)
 
 
 @dataclass
@@ -72,15 +83,31 @@ class Insertion:
     fixed_nodes: np.ndarray
     total_depth: float
     tip_end: float
+    resistance: TipResistance | None = None
 
 
 def build_insertion(case: InsertionCase) -> Insertion:
     """Bodies, contact, constraints and manoeuvre of ``case`` (SI inside)."""
     case.validate()
     D = case.diameter_mm * 1e-3
-    geometry = colon_geometry(case.segment, D, case.angle_deg, case.element_size_mm * 1e-3,
-                              case.wall_thickness_mm * 1e-3, case.exit_length_mm * 1e-3, case.flexure_angle_deg,
+    anatomy = colon_model(case.segment)
+
+    def geometry_with_exit(exit_length):
+        return colon_geometry(case.segment, D, case.angle_deg, case.element_size_mm * 1e-3,
+                              case.wall_thickness_mm * 1e-3, exit_length, case.flexure_angle_deg,
                               centerline=case.patient_centerline())
+
+    exit_length = case.exit_length_mm * 1e-3
+    geometry = geometry_with_exit(exit_length)
+    if anatomy.exit_takes_length:
+        before_exit = geometry.centerline_length - exit_length
+        length = anatomy.scope_length_for(geometry.centerline_length, case.sheath_reserve_mm * 1e-3)
+        needed = length - case.sheath_reserve_mm * 1e-3 - before_exit + EXIT_MARGIN
+        if needed > EXIT_LIMIT:
+            raise ColonsimError(f"the exit would need {needed * 100:.0f} cm to take the scope's available length, "
+                                f"more than {EXIT_LIMIT * 100:.0f} cm; keep more in the sheath (sheath_reserve_mm)")
+        if needed > exit_length:
+            geometry = geometry_with_exit(needed)
     material = case_material(case.material, case.material_parameters)
     shell = Shell(geometry.nodes, geometry.triangles, case.wall_thickness_mm * 1e-3, material,
                   density=COLON_DENSITY, name="colon")
@@ -89,7 +116,6 @@ def build_insertion(case: InsertionCase) -> Insertion:
     entry = np.asarray(geometry.entry_point, dtype=float)
     axis = np.asarray(geometry.entry_axis, dtype=float)
     axis = axis / np.linalg.norm(axis)
-    anatomy = colon_model(case.segment)
     length = anatomy.scope_length_for(geometry.centerline_length, case.sheath_reserve_mm * 1e-3)
     total_depth = length - case.sheath_reserve_mm * 1e-3
     tip_end = geometry.end_depth
@@ -128,11 +154,32 @@ def build_insertion(case: InsertionCase) -> Insertion:
     constraints += [drive, sheath]
     # the sheath's lip supports the scope where it leaves, between nodes (a smooth exit)
     lip = SheathLip(rod, entry, axis, -0.5 * scope.diameter)
+    resistance = None
+    if case.distal_resistance_N > 0.0 and geometry.exit_start is not None:
+        resistance = TipResistance(rod, rod.tip_node, lumen_direction(geometry, geometry.exit_start),
+                                   case.distal_resistance_N, creep_speed=DISTAL_CREEP_SHARE * case.push_speed,
+                                   engagement=0.0)
     solver = ExplicitSolver([rod, shell], contacts=[contact, lip], constraints=constraints,
                             damping={rod.name: case.scope_damping, "colon": case.colon_damping},
-                            time_step_factor=case.time_step_factor)
+                            time_step_factor=case.time_step_factor, resistances=[resistance] if resistance else [])
     return Insertion(case, geometry, shell, rod, scope, contact, push, solver, drive, entry, axis, mobile, held,
-                     total_depth, tip_end)
+                     total_depth, tip_end, resistance)
+
+
+def resistance_share(geometry, tip_arc) -> float:
+    """Share of the distal resistance engaged with the tip at ``tip_arc`` along the centerline (m):
+    0 before the fixed exit, rising linearly to 1 over its first :data:`DISTAL_RAMP`."""
+    return float(np.clip((tip_arc - geometry.exit_start) / DISTAL_RAMP, 0.0, 1.0))
+
+
+def lumen_direction(geometry, s) -> np.ndarray:
+    """Unit tangent of the centerline at arc length ``s`` (m), over the next millimetre (at the
+    start of the exit: the exit's own direction)."""
+    ends = np.clip([s, s + 1e-3], 0.0, geometry.centerline_length)
+    if ends[1] - ends[0] < 5e-4:
+        ends[0] = ends[1] - 1e-3
+    p = np.asarray(geometry.centerline_points(ends))
+    return (p[1] - p[0]) / np.linalg.norm(p[1] - p[0])
 
 
 @dataclass
@@ -183,18 +230,25 @@ def run_insertion(case: InsertionCase, progress=None, snapshot_interval=None) ->
         last = recorder.rows[-1]
         if progress is not None:
             progress(model.solver.time, last["tip_arc_m"], model.tip_end)
+        held = False
+        if model.resistance is not None:  # engaged by where the tip is, along the lumen there (an exit may bend)
+            share = resistance_share(model.geometry, last["tip_arc_m"])
+            model.resistance.engage(share, lumen_direction(model.geometry, max(last["tip_arc_m"], model.geometry.exit_start)))
+            held = share > 0.0
         if ended_by is not None:
             continue
-        if push.settle_start is not None and model.solver.time >= push.settle_start:
+        if last["max_stretch"] > case.failure_stretch:
+            ended_by = "wall_stretch"
+        elif push.settle_start is not None and model.solver.time >= push.settle_start:
             ended_by = "length_used"
         elif model.solver.time >= last_push.start and tip_passed_end(last, model):
             ended_by = "tip_past_end" if model.geometry.end_depth < model.geometry.centerline_length else "far_end"
-        elif recorder.jammed():
+        elif not held and recorder.jammed():
             ended_by = "jam"
         if ended_by is None:
             continue
-        if ended_by == "jam" or push.settle_start is None:
-            break  # a jam ends where the tip stuck, under its load; a profile without a settle phase, at its rule
+        if ended_by in ("jam", "wall_stretch") or push.settle_start is None:
+            break  # a jam or a tear ends where it happened, under its load; a profile without a settle phase, at its rule
         push.stop(model.solver.time, case.stop_distance_mm * 1e-3, case.settle_s)
     ended_by = ended_by or "length_used"
     wall = time.perf_counter() - t0

@@ -14,6 +14,7 @@ from colonsim.insertion.engine.constraints import FREE, ON_LINE
 from colonsim.insertion.engine.integrator_kernels import (advance_kernel, advance_kernel_serial, velocity_kernel,
                                                           velocity_kernel_serial)
 from colonsim.insertion.engine.rod_damping import damped_rod_velocity, merge_rows
+from colonsim.insertion.engine.tip_resistance import resisted_update
 
 
 class BodyState:
@@ -79,22 +80,31 @@ def constraint_rows(s, constraints, t, t_mid):
     return rows
 
 
-def step_body(s, constraints, alpha, t, t_mid, dt_mid, dt):
+def step_body(s, constraints, alpha, t, t_mid, dt_mid, dt, resistances=()):
     """Velocity update (damping ``alpha``, 1/s), ``constraints`` of this body (their ``reaction``
     set), then positions; returns the work done on the body by each force family during the
-    step (internal, contact, external, damping, reaction; J) and its mid-step kinetic energy."""
+    step (internal, contact, external, damping, reaction; J) and its mid-step kinetic energy.
+    ``resistances``: :class:`~colonsim.insertion.engine.tip_resistance.TipResistance` objects on
+    this body, taken implicitly with the velocity update."""
     b = s.body
+    outputs = (s.v_new, s.f_damp, s.reaction)
     if s.implicit:
         rows = constraint_rows(s, constraints, t, t_mid)
-        damped_rod_velocity(s.x, s.v, s.f_int, s.f_con, s.f_ext, b.mass, alpha, b.lateral_damping, b.dashpot,
-                            s.row_kind, s.row_dir, s.row_target, dt_mid, s.v_new, s.f_damp, s.reaction)
+
+        def update():
+            damped_rod_velocity(s.x, s.v, s.f_int, s.f_con, s.f_ext, b.mass, alpha, b.lateral_damping, b.dashpot,
+                                s.row_kind, s.row_dir, s.row_target, dt_mid, s.v_new, s.f_damp, s.reaction)
+        resisted_update(resistances, s, update, outputs)
         share_reactions(rows, s.reaction)
         for c in constraints:
             if not c.active(t):
                 c.reaction = np.zeros(3)
     else:
         kernel = velocity_kernel if s.parallel else velocity_kernel_serial
-        kernel(s.v, s.f_int, s.f_con, s.f_ext, b.mass, s.fixed, alpha, dt_mid, s.v_new, s.f_damp, s.reaction)
+
+        def update():
+            kernel(s.v, s.f_int, s.f_con, s.f_ext, b.mass, s.fixed, alpha, dt_mid, s.v_new, s.f_damp, s.reaction)
+        resisted_update(resistances, s, update, outputs)
         for c in constraints:
             c.reaction = c.constrain_rates(t_mid, s, dt_mid) if c.active(t) else np.zeros(3)
     kernel = advance_kernel if s.parallel else advance_kernel_serial

@@ -72,6 +72,9 @@ class ExplicitSolver:
         velocity, line).
     loads : list
         :class:`~colonsim.insertion.engine.constraints.NodalLoad` objects.
+    resistances : list
+        :class:`~colonsim.insertion.engine.tip_resistance.TipResistance` objects (a resisted tip),
+        taken implicitly with their body's velocity update.
     damping : float or dict
         Mass-proportional damping coefficient alpha (1/s), one for all bodies or per body name.
         Critical damping of a mode of angular frequency w is alpha = 2 w.
@@ -101,7 +104,7 @@ class ExplicitSolver:
 
     def __init__(self, bodies, contacts=(), constraints=(), loads=(), damping=0.0, time_step=None,
                  time_step_factor=0.9, time_step_interval=100, time_step_growth=1.05, mass_scaling=None, initial_velocity=None,
-                 energy_growth_limit=10.0, parallel_min_nodes=50_000):
+                 energy_growth_limit=10.0, parallel_min_nodes=50_000, resistances=()):
         names = [b.name for b in bodies]
         if len(set(names)) != len(names):
             raise ColonsimError(f"body names must be unique, got {names}; rename the bodies.")
@@ -113,7 +116,8 @@ class ExplicitSolver:
         self.contacts = list(contacts)
         self.constraints = list(constraints)
         self.loads = list(loads)
-        for item in self.constraints + self.loads:
+        self.resistances = list(resistances)
+        for item in self.constraints + self.loads + self.resistances:
             if item.body not in self.bodies:
                 raise ColonsimError(
                     f"a constraint or load acts on body '{item.body.name}', which is not in the solver; add the body."
@@ -244,7 +248,8 @@ class ExplicitSolver:
         for b in self.bodies:
             s = self.state[b.name]
             w_int, w_con, w_ext, w_damp, w_react, kinetic = step_body(
-                s, [c for c in self.constraints if c.body is b], self.damping[b.name], t, t + 0.5 * dt, dt_mid, dt)
+                s, [c for c in self.constraints if c.body is b], self.damping[b.name], t, t + 0.5 * dt, dt_mid, dt,
+                [r for r in self.resistances if r.body is b])
             s.kinetic = kinetic
             s.work_internal += w_int
             s.work_contact += w_con

@@ -76,6 +76,40 @@ scope = ["9.2", "13.3"]
 angle_deg = 45
 flexure_angle_deg = [135, 180]
 """,
+    # The distal resistance study (docs/model.md, "Loading"): every colon model at the four clinical
+    # levels 0 / 5 / 10 / 20 N, the source's angles and the three meshed scopes (132 runs), and
+    # the rate check at 10 N (half the push speed) of the thickest scope in one case per model (4).
+    "resistance": """
+[sweep]
+name = "resistance"
+description = "Distal resistance 0 / 5 / 10 / 20 N: RSJ D23/D36, RSF alpha, THF and fixed THF beta 0/30/45, scopes 9.2 / 11.1 / 13.3 mm, and the rate check at 10 N"
+
+[[grid]]
+segment = "rsj"
+scope = ["9.2", "11.1", "13.3"]
+diameter_mm = [23, 36]
+distal_resistance_N = [0, 5, 10, 20]
+
+[[grid]]
+segment = ["rsf", "thf", "thf-fixed"]
+scope = ["9.2", "11.1", "13.3"]
+angle_deg = [0, 30, 45]
+distal_resistance_N = [0, 5, 10, 20]
+
+[[grid]]
+segment = "rsj"
+scope = "13.3"
+diameter_mm = 36
+distal_resistance_N = 10
+push_speed = 0.15
+
+[[grid]]
+segment = ["rsf", "thf", "thf-fixed"]
+scope = "13.3"
+angle_deg = 45
+distal_resistance_N = 10
+push_speed = 0.15
+""",
     # A few runs of a few seconds each on a coarse wall mesh: for tests and for checking a setup.
     "smoke": """
 [sweep]

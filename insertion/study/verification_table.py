@@ -18,6 +18,7 @@ from colonsim.insertion.study.verification_contact import (damped_push_balance, 
                                                            tip_on_node)
 from colonsim.insertion.study.verification_damping import (axial_damping_decay, lateral_damping_decay, lip_cantilever,
                                                            sliding_push_force)
+from colonsim.insertion.study.verification_resistance import above_euler, below_euler, creep
 from colonsim.insertion.study.verification_rod import (axial_wave, buckling_check, cantilever_tip_deflection,
                                                        euler_buckling_load)
 from colonsim.insertion.study.verification_rules import SAME, Bound, Check, Equal, Relative, Run, Verdict
@@ -147,6 +148,28 @@ CHECKS: tuple[Check, ...] = (
           "held node by node the sheath's clamp jumps by a node spacing whenever a node leaves it (a spread of "
           "about 3 h / L over the positions, measured 0.077); the lip's spring supports the point at the lip on "
           "the segment that straddles it, which moves smoothly (measured 0.023)"),
+    # --- distal resistance (docs/model.md, "Loading") ---
+    Check("resistance.push_below", "resistance", "push force against a tip resistance of 0.5 P_E: the resistance "
+          "(scope pushed 1 mm out of its sheath, 15 cm span, 5 mm segments)", Run(below_euler, pick=0),
+          (Relative(0.02),),
+          "below its Euler load the span stays straight and slides once the push force reaches the resistance; the "
+          "tip then moves at the push speed, 100 times the creep speed, where the regularised law gives the full "
+          "resistance, and a sliding scope feels no damping (damping.no_drag)"),
+    Check("resistance.straight_below", "resistance", "tip deflection / L at 0.5 P_E under a lateral imperfection "
+          "load 1e-3 P, beam-column theory", Run(below_euler, pick=1), (Bound(upper=2e-3),),
+          "the rod stays straight: the deflection stays at the beam-column value of a column clamped up to one node "
+          "spacing behind the lip (measured 9.4e-4 against 8.0e-4 at the lip: the clamp's offset, 3 % of L, grows "
+          "both the lever and P / P_E), 45 times below the buckled span's (resistance.buckling_above)"),
+    Check("resistance.buckling_above", "resistance", "push force of the span under a tip resistance of 2 P_E: the "
+          "Euler load pi^2 EI / (4 L^2) of a column clamped at the lip", Run(above_euler),
+          (Relative(0.07), Bound(lower=0.02, of="deflection"), Bound(upper=1e-4, of="advance_m")),
+          "the held span buckles at its Euler load and the tip does not advance; the discrete rod's clamp lies "
+          "between the lip and one node spacing h behind it, a load between (L / (L + h))^2 = 0.94 and 1 times "
+          "Euler's, and the post-buckled elastica carries up to 0.2 % more at the measured deflection"),
+    Check("resistance.creep", "resistance", "creep speed of a free scope pushed by half its tip's resistance, v_c / 2",
+          Run(creep), (Relative(0.01),),
+          "the regularised law is linear below the creep speed, and it is solved implicitly with the velocity "
+          "update: the steady speed is exact once the axial waves of the start have decayed (tau = 3 ms)"),
     Check("contact.resting_penetration", "contact", "penetration F / (n k) of a rod resting on n wall nodes",
           Run(rod_resting_on_wall, (1.0,), pick=0),
           (Relative(0.005), Equal("active contacts", 11), Equal("nodes under the rod", 11)),

@@ -1,0 +1,168 @@
+"""The validation report's section on the distal resistance (docs/model.md, "Loading"), read from
+a sweep of the ``resistance`` preset (``colonsim sweep --preset resistance --out DIR``, passed as
+``--resistance-sweep DIR``).
+
+Per colon model and level: every scope's final and largest deformation, its lag, the peak contact
+and push forces, how the run ended and its ringing ratio; RSF/THF laid out like the source's
+comparison (rows: angle; columns: UTC - SDC and PDC - SDC final deformation); RSJ's points A, B,
+C per level and whether C > A once the tip is held back; and the rate check at 10 N (half the push
+speed) of one case per model. Runs missing from the table are listed, never filled in.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from colonsim.insertion.case.insertion_case import InsertionCase
+from colonsim.insertion.case.outcomes import RINGING_LIMIT
+from colonsim.markdown import md_table, num
+from validation_sweeps import role, scope_label
+
+LEVELS_N = (0.0, 5.0, 10.0, 20.0)
+RATE_LIMITS = {"point_A_cm": 0.05, "point_C_cm": 0.05, "final_deformation_cm": 0.05, "max_deformation_cm": 0.05,
+               "peak_contact_force_N": 0.10, "peak_push_force_N": 0.10}
+NOT_RUN = "**NOT RUN**"
+
+
+def _number(row, column):
+    value = row.get(column) if row is not None else None
+    return float(value) if value is not None and np.isfinite(value) else None
+
+
+def _where(case):
+    if case.segment == "rsj":
+        return f"D {case.diameter_mm:g} mm"
+    return f"{'alpha' if case.segment == 'rsf' else 'beta'} {case.angle_deg:g} deg"
+
+
+def resistance_section(sweep) -> dict:
+    """Rows of every run of the sweep at the default push speed, the source-style differences, the
+    RSJ points and the rate pairs."""
+    if not sweep.ran:
+        return {"ran": False}
+    speed = InsertionCase().push_speed
+    rows, missing = [], []
+    for case in sweep.cases:
+        if not math.isclose(case.push_speed, speed):
+            continue
+        row, status = sweep.run(case)
+        if row is None:
+            missing.append(f"{case.segment.upper()} {scope_label(case)} {_where(case)} {case.distal_resistance_N:g} N: "
+                           f"{status}")
+            continue
+        rows.append({"segment": case.segment, "where": _where(case), "scope": scope_label(case), "role": role(case),
+                     "angle_deg": case.angle_deg, "diameter_mm": case.diameter_mm,
+                     "level_N": case.distal_resistance_N, **{c: _number(row, c) for c in (
+                         "final_deformation_cm", "max_deformation_cm", "max_lag_cm", "final_lag_cm",
+                         "peak_contact_force_N", "peak_push_force_N", "point_A_cm", "point_B_cm", "point_C_cm",
+                         "ringing_ratio")},
+                     "ended_by": str(row.get("ended_by", ""))})
+    return {"ran": True, "rows": rows, "missing": missing, "differences": _differences(rows),
+            "rsj": [r for r in rows if r["segment"] == "rsj"], "rate": _rate_pairs(sweep, speed),
+            "quasi_static": _quasi_static(rows)}
+
+
+def _differences(rows) -> list:
+    """RSF/THF per level and angle: UTC - SDC and PDC - SDC final deformation (cm), as the source."""
+    out = []
+    for segment in ("rsf", "thf", "thf-fixed"):
+        for level in LEVELS_N:
+            for angle in sorted({r["angle_deg"] for r in rows if r["segment"] == segment}):
+                final = {r["role"]: r["final_deformation_cm"] for r in rows
+                         if r["segment"] == segment and r["level_N"] == level and r["angle_deg"] == angle}
+                if not final:
+                    continue
+                sdc = final.get("sdc")
+
+                def minus(name, sdc=sdc, final=final):
+                    return None if final.get(name) is None or sdc is None else final[name] - sdc
+                out.append({"segment": segment, "level_N": level, "angle_deg": angle, "utc_minus_sdc": minus("utc"),
+                            "pdc_minus_sdc": minus("pdc")})
+    return out
+
+
+def _quasi_static(rows) -> dict:
+    ratios = [r["ringing_ratio"] for r in rows if r["ringing_ratio"] is not None]
+    above = [f"{r['segment'].upper()} {r['scope']} {r['where']} {r['level_N']:g} N: {num(r['ringing_ratio'])}"
+             for r in rows if r["ringing_ratio"] is not None and r["ringing_ratio"] >= RINGING_LIMIT]
+    return {"runs": len(rows), "measured": len(ratios), "below": sum(x < RINGING_LIMIT for x in ratios),
+            "largest": max(ratios) if ratios else None, "above": above}
+
+
+def _rate_pairs(sweep, speed) -> list:
+    """Each half-speed run against the run with the same inputs at the default speed."""
+    by_inputs = {}
+    for case in sweep.cases:
+        key = (case.segment, str(case.scope), case.diameter_mm, case.angle_deg, case.distal_resistance_N)
+        by_inputs.setdefault(key, {})[case.push_speed] = case
+    out = []
+    for key, cases in by_inputs.items():
+        slow = [s for s in cases if s < speed * 0.99]
+        if speed not in cases or not slow:
+            continue
+        base, variant = (sweep.run(cases[s])[0] for s in (speed, slow[0]))
+        row = {"segment": key[0], "scope": scope_label(cases[speed]), "where": _where(cases[speed]), "level_N": key[4],
+               "changes": {}, "passed": None}
+        if base is not None and variant is not None:
+            for column, limit in RATE_LIMITS.items():
+                a, b = _number(base, column), _number(variant, column)
+                change = None if a is None or b is None or a == 0 else (b - a) / abs(a)
+                row["changes"][column] = {"change": change, "limit": limit,
+                                          "passed": None if change is None else abs(change) < limit}
+            judged = [c["passed"] for c in row["changes"].values() if c["passed"] is not None]
+            row["passed"] = all(judged) if judged else None
+        out.append(row)
+    return out
+
+
+def markdown(section) -> list:
+    """The section's Markdown lines."""
+    lines = ["## 14. Distal resistance", "",
+             "The colon beyond the model holds the tip back (docs/model.md, \"Loading\", distal resistance): the "
+             "`resistance` preset runs every colon model at 0 / 5 / 10 / 20 N (none, light, typical, difficult), the "
+             "source's angles and the three meshed scopes, and the rate check at 10 N. Lag: pushed depth minus the "
+             "tip's advance along the centerline.", ""]
+    if not section["ran"]:
+        return lines + [f"{NOT_RUN}: no --resistance-sweep (`colonsim sweep --preset resistance --out DIR`).", ""]
+    qs = section["quasi_static"]
+    lines += [f"Quasi-static: {qs['below']} of {qs['measured']} measured runs ring below {RINGING_LIMIT:g} (largest "
+              f"{num(qs['largest'])})" + (": above it " + "; ".join(qs["above"]) if qs["above"] else "") + ".", ""]
+    if section["missing"]:
+        lines += [f"Missing runs ({len(section['missing'])}): " + "; ".join(section["missing"]) + ".", ""]
+    for segment in ("rsj", "rsf", "thf", "thf-fixed"):
+        rows = [r for r in section["rows"] if r["segment"] == segment]
+        if not rows:
+            continue
+        lines += [f"### {segment.upper()}", "",
+                  md_table(rows, [("level [N]", lambda r: f"{r['level_N']:g}"), ("case", "where"), ("scope", "scope"),
+                                  ("final [cm]", "final_deformation_cm"), ("max [cm]", "max_deformation_cm"),
+                                  ("lag max / final [cm]", lambda r: f"{num(r['max_lag_cm'])} / {num(r['final_lag_cm'])}"),
+                                  ("peak contact [N]", "peak_contact_force_N"), ("peak push [N]", "peak_push_force_N"),
+                                  ("ended by", "ended_by"), ("ringing", "ringing_ratio")]), ""]
+    rsj = section["rsj"]
+    if rsj:
+        lines += ["RSJ points per level (C > A: the loop behind a held tip grows):", "",
+                  md_table(rsj, [("level [N]", lambda r: f"{r['level_N']:g}"), ("case", "where"), ("scope", "scope"),
+                                 ("A", "point_A_cm"), ("B", "point_B_cm"), ("C", "point_C_cm"),
+                                 ("C > A", lambda r: "-" if r["point_A_cm"] is None or r["point_C_cm"] is None
+                                  else ("yes" if r["point_C_cm"] > r["point_A_cm"] else "no"))]), ""]
+    diffs = section["differences"]
+    if diffs:
+        lines += ["Laid out like the source (final deformation differences, cm; negative: the thinner scope deforms "
+                  "less):", "",
+                  md_table(diffs, [("model", lambda r: r["segment"].upper()), ("level [N]", lambda r: f"{r['level_N']:g}"),
+                                   ("angle [deg]", lambda r: f"{r['angle_deg']:g}"), ("UTC - SDC", "utc_minus_sdc"),
+                                   ("PDC - SDC", "pdc_minus_sdc")]), ""]
+    if section["rate"]:
+        lines += ["Rate check at half the push speed (limits: 5 % on A, C, final, max; 10 % on peak forces):", "",
+                  md_table(section["rate"], [("model", lambda r: r["segment"].upper()), ("scope", "scope"),
+                                             ("case", "where"), ("level [N]", lambda r: f"{r['level_N']:g}"),
+                                             *[(c, (lambda r, c=c: "-" if c not in r["changes"] or
+                                                    r["changes"][c]["change"] is None
+                                                    else f"{100 * r['changes'][c]['change']:+.1f} %"))
+                                               for c in RATE_LIMITS],
+                                             ("passes", lambda r: {True: "yes", False: "NO", None: "-"}[r["passed"]])]),
+                  ""]
+    return lines

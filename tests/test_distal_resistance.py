@@ -1,0 +1,117 @@
+"""The distal resistance (docs/model.md, "Loading"): its regularised law in closed form, nothing
+changed at 0 N, where it acts in each colon model, and its place in keys, tables and queries."""
+
+import math
+
+import numpy as np
+import pytest
+
+from colonsim import catalog
+from colonsim.errors import ColonsimError
+from colonsim.insertion.case.scenario import EXIT_MARGIN, InsertionCase, build_insertion, resistance_share
+from colonsim.insertion.engine.constraints import LineConstraint, PrescribedVelocity
+from colonsim.insertion.engine.rod import Rod
+from colonsim.insertion.engine.solver import ExplicitSolver
+from colonsim.insertion.engine.tip_resistance import TipResistance, regularised_force
+
+COARSE_MM = 7.5
+
+
+@pytest.mark.parametrize("u0", [1e-3, -1e-3, 0.0, 0.2, 1.0, -1.0])
+def test_regularised_law_is_solved_at_the_new_velocity(u0):
+    R, vc, b = 5.0, 0.003, 0.01  # b: the tip's velocity change per newton over the step
+    F = regularised_force(u0, b, R, vc)
+    u = u0 + b * F
+    assert F == pytest.approx(-R * max(-1.0, min(1.0, u / vc)), abs=1e-12)  # the law holds at the new velocity
+    if abs(u0) <= vc + b * R:  # creeping: u = u0 / (1 + b R / v_c)
+        assert u == pytest.approx(u0 / (1.0 + b * R / vc), abs=1e-15)
+    else:  # sliding either way: the full resistance against the motion
+        assert F == -math.copysign(R, u0)
+
+
+def test_plain_coulomb_sticks_then_slips():
+    assert regularised_force(0.02, 0.01, 5.0, 0.0) == pytest.approx(-2.0)  # stuck: the velocity is cancelled
+    assert regularised_force(0.2, 0.01, 5.0, 0.0) == -5.0  # slipping: the full resistance
+
+
+def _pushed_rod(resistances=()):
+    rod = Rod.straight(0.3, 12.8e-3, 16e6, 2944.0, spacing=5e-3, damping_time=3e-3, lateral_damping=200.0)
+    drive = PrescribedVelocity(rod, [0], (0.3, 0.0, 0.0), ramp=0.02)
+    sheath = LineConstraint(rod, (0.0, 0.0, 0.0), (1.0, 0.0, 0.0), extent=(-math.inf, 0.1))
+    resisted = [TipResistance(rod, rod.tip_node, (1.0, 0.0, 0.0), force, creep_speed=3e-3)
+                for force in resistances]
+    sim = ExplicitSolver([rod], constraints=[drive, sheath], resistances=resisted)
+    sim.run(0.05, record_interval=1e-3)
+    return sim, drive
+
+
+def test_zero_resistance_changes_nothing_bit_for_bit():
+    free, _ = _pushed_rod()
+    zero, _ = _pushed_rod([0.0])
+    assert np.array_equal(free.state["scope"].x, zero.state["scope"].x)
+    assert np.array_equal(free.state["scope"].v, zero.state["scope"].v)
+    held, drive = _pushed_rod([2.0])
+    assert not np.array_equal(free.state["scope"].x, held.state["scope"].x)
+    assert drive.reaction[0] == pytest.approx(2.0, rel=0.05)  # the push now carries the resistance
+
+
+def test_zero_resistance_builds_no_resistance_and_keeps_the_key_of_before():
+    case = InsertionCase(segment="rsf", angle_deg=45.0, element_size_mm=COARSE_MM, distal_resistance_N=0.0)
+    assert build_insertion(case).resistance is None
+    inputs = case.to_dict()
+    del inputs["distal_resistance_N"], inputs["failure_stretch"]  # the fields the runs of before lacked
+    for name in ("centerline", "centerline_smoothing_mm", "material_parameters"):
+        del inputs[name]
+    import hashlib
+    import json
+
+    assert case.key() == hashlib.sha256(json.dumps(inputs, sort_keys=True).encode()).hexdigest()[:12]
+    assert InsertionCase(distal_resistance_N=5.0).key() != InsertionCase(distal_resistance_N=0.0).key()
+
+
+@pytest.mark.parametrize("segment, angle", [("rsj", 0.0), ("rsf", 45.0), ("thf", 45.0), ("thf-fixed", 0.0)])
+def test_the_resistance_waits_at_the_exit_and_the_exit_takes_the_length(segment, angle):
+    model = build_insertion(InsertionCase(segment=segment, angle_deg=angle, element_size_mm=COARSE_MM))
+    g, r = model.geometry, model.resistance
+    assert r is not None and r.resistance == 5.0 and r.creep_speed == pytest.approx(0.01 * model.case.push_speed)
+    assert r.engagement == 0.0  # the tip starts at the entry, far before the exit
+    assert resistance_share(g, g.exit_start - 1e-3) == 0.0 and resistance_share(g, g.exit_start + 1e-2) == 1.0
+    assert resistance_share(g, g.exit_start + 5e-3) == pytest.approx(0.5)
+    if catalog.colon_model(segment).exit_takes_length:
+        assert g.centerline_length >= model.total_depth + EXIT_MARGIN - 1e-9  # the far end is out of reach
+    else:
+        assert g.centerline_length == pytest.approx(g.exit_start + 0.1)  # RSJ keeps its 10 cm exit
+
+
+def test_the_straight_tube_has_no_exit_to_resist_in():
+    assert build_insertion(InsertionCase(segment="straight", element_size_mm=COARSE_MM)).resistance is None
+
+
+@pytest.mark.parametrize("value", [-1.0, 101.0, math.nan])
+def test_a_resistance_outside_its_range_is_refused_in_one_line(value):
+    with pytest.raises(ColonsimError, match="distal_resistance_N .* outside"):
+        InsertionCase(distal_resistance_N=value).validate()
+
+
+def test_the_results_table_and_the_surrogate_know_the_resistance():
+    assert catalog.COLUMNS["distal_resistance_N"].surrogate == catalog.SURROGATE_INPUT
+    assert catalog.COLUMNS["distal_resistance_N"].option == "--distal-resistance"
+    for name in ("max_lag_cm", "final_lag_cm"):
+        assert catalog.COLUMNS[name].kind == catalog.OUTPUT
+
+
+def test_a_surrogate_fitted_over_the_resistance_needs_it_in_every_query():
+    from colonsim.surrogate import SweepSurrogate
+    from colonsim.surrogate.synthetic import synthetic_sweep
+
+    table = synthetic_sweep(n_runs=24, segments=("rsf",), noise_cm=0.01, n_failed=0, seed=3)
+    level = np.resize([0.0, 5.0, 10.0, 20.0], len(table))
+    table = table.assign(distal_resistance_N=level,
+                         final_deformation_cm=table["final_deformation_cm"] + 0.05 * level)  # SYNTHETIC
+    model = SweepSurrogate(targets=("final_deformation_cm",), n_restarts=0).fit(table)
+    assert "distal_resistance_N" in model.domains_["rsf"].inputs
+    query = {"scope": "pdc", "angle_deg": 30.0, "friction": 0.05}
+    with pytest.raises(ColonsimError, match="give distal_resistance_N .*--distal-resistance on the command line"):
+        model.predict(query, "rsf")
+    low, high = (model.predict({**query, "distal_resistance_N": r}, "rsf")[0] for r in (0.0, 20.0))
+    assert high > low + 0.5  # it learned the resistance's effect
