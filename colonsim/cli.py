@@ -111,7 +111,8 @@ def _add_insert(sub):
     p.add_argument("--flexure-angle", type=finite_float, default=90.0,
                    help="turn of the splenic (RSF) or hepatic (THF) flexure, degrees (default 90, an assumption)")
     p.add_argument("--exit-length", type=finite_float, default=100.0,
-                   help="mm of fixed colon after the last mobile piece (default 100, an assumption)")
+                   help="mm of fixed colon after the last mobile piece (default 100, an assumption; in RSF/THF a "
+                        "minimum: the exit is lengthened to take the whole scope)")
     p.add_argument("--distal-resistance", type=finite_float, default=5.0,
                    help="N the colon beyond the model opposes to the tip's advance once it is in the fixed exit "
                         "(default 5, the light level of 0/5/10/20; 0: none; docs/model.md, \"Loading\")")

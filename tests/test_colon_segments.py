@@ -227,7 +227,7 @@ def test_geometry_errors(args, message):
 
 
 @pytest.mark.parametrize("segment", ["rsj", "rsf", "thf"])
-@pytest.mark.parametrize("exit_length", [-0.01, 0.31, float("nan")])
+@pytest.mark.parametrize("exit_length", [-0.01, 0.41, float("nan")])
 def test_exit_length_out_of_range(segment, exit_length):
     with pytest.raises(ColonsimError, match="exit length .* must lie in 0-400 mm"):
         colon_geometry(segment, D, 0.0, H, T, exit_length=exit_length)

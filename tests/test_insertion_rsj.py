@@ -75,10 +75,14 @@ def test_standard_scope_passes_the_junction_on_the_default_mesh(junction_run):
 
 
 @pytest.mark.slow
-def test_runs_pass_into_the_exit_and_stay_quasi_static(rsj_runs):
+def test_runs_are_held_back_in_the_exit_and_stay_quasi_static(rsj_runs):
+    """At the default 5 N distal resistance the tip enters the exit and is held back there: the
+    run ends 2 cm into it or when the available length is used (a lag, not a jam)."""
     for r in rsj_runs.values():
-        _check_passed_into_exit(r)
         s = r.summary
+        assert s["ended_by"] in ("tip_past_end", "length_used"), s["end"]
+        assert s["final_tip_arc_cm"] > 100 * r.model.geometry.exit_start
+        assert s["distal_resistance"]["acting"] and s["distal_resistance"]["max_force_N"] > 0.0
         assert s["quasi_static"]["energy"]["fraction_below_10pct"]["colon"] > 0.5
         assert s["quasi_static"]["holds"], s["quasi_static"]
         assert r.timeseries.notna().all().all()
