@@ -153,10 +153,13 @@ def _format_result(r) -> str:
 def _print_warnings(results):
     from colonsim.identification.diagnostics import misfit_warning
 
+    from colonsim.identification.report import strip_stability
+
     for r in results:
-        warning = misfit_warning(r)
-        if warning:
-            print(f"colonsim: warning: {warning}", file=sys.stderr, flush=True)
+        unstable = strip_stability(r).warning()
+        for warning in (misfit_warning(r), unstable and f"{r.curve.name}: {unstable}"):
+            if warning:
+                print(f"colonsim: warning: {warning}", file=sys.stderr, flush=True)
 
 
 def calibrate(request: CalibrationRequest, out: Path) -> list:
