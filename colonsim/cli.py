@@ -80,7 +80,9 @@ def cmd_calibrate(args):
         per_specimen=args.per_specimen, law=args.law, compare_laws=args.compare_laws, analytic=args.analytic,
         mesh=args.mesh, points=args.points, quick=args.quick, seed=args.seed, workers=args.workers,
         show_progress=not args.no_progress, given_as="--{}")
+    cli_material.check_export(args)
     calibrate(request, args.out)
+    cli_material.export_after(args)
 
 
 def cmd_demo(args):
@@ -172,6 +174,7 @@ def build_parser():
     sub = parser.add_subparsers(dest="command", required=True)
     _add_calibrate(sub)
     _add_insert(sub)
+    cli_material.add_parsers(sub)
     cli_sweep.add_parser(sub)
     cli_surrogate.add_parsers(sub)
     demo = sub.add_parser("demo", help="run the workflows on the bundled data (a few minutes on 2 cores)")

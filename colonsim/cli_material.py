@@ -1,9 +1,13 @@
-"""The ``calibrate`` options of multi-mode fits (the command line's share of
-:mod:`colonsim.calibrate_modes`); :mod:`colonsim.cli` adds them to its ``calibrate`` parser."""
+"""The command line of multi-mode fits and material cards: the ``calibrate`` options of
+:mod:`colonsim.calibrate_modes` and ``--export``, which :mod:`colonsim.cli` adds to its ``calibrate``
+parser, and ``colonsim material export`` for an existing material.json."""
 
 from __future__ import annotations
 
-from colonsim.options import finite_float
+from pathlib import Path
+
+from colonsim.identification.cards import DENSITY, FORMATS
+from colonsim.options import finite_float, output_folder
 
 
 def add_calibrate_options(parser):
@@ -19,6 +23,72 @@ def add_calibrate_options(parser):
     g.add_argument("--stability-range", type=finite_float, nargs=2, metavar=("LOW", "HIGH"),
                    help="stretches over which every fitted law is checked for Drucker stability "
                         "(default 0.5 to twice the largest tested stretch)")
+    parser.add_argument("--export", nargs="+", choices=FORMATS, metavar="FORMAT",
+                        help=f"also write the fitted law as material cards: {', '.join(FORMATS)} (material_<format>.* in --out)")
+
+
+def add_parsers(sub):
+    """``colonsim material export``."""
+    p = sub.add_parser("material", help="material files: export a calibration's law as cards for other solvers")
+    msub = p.add_subparsers(dest="material_command", required=True)
+    e = msub.add_parser("export", help="write material.json's law as LS-DYNA, Abaqus, ANSYS or FEBio cards",
+                        description="Write the law of a colonsim material.json as material cards (units tonne, mm, s, N, "
+                                    "MPa; bulk modulus 1000 mu0; docs/calibration.md).")
+    e.add_argument("material", type=Path, help="material.json written by colonsim calibrate")
+    e.add_argument("--format", nargs="+", required=True, choices=FORMATS, help="one or more of " + ", ".join(FORMATS))
+    e.add_argument("--out", type=output_folder, default=None, help="output folder (default: the material file's folder)")
+    e.add_argument("--density", type=finite_float, default=DENSITY,
+                   help=f"density written into the cards, kg/m^3 (default {DENSITY:g}, the colon wall's)")
+    e.set_defaults(func=cmd_material_export)
+
+
+def _law_and_parameters(path):
+    from colonsim.errors import ColonsimError
+    from colonsim.identification.hyperelastic import calibration_law
+    from colonsim.insertion.engine.material import read_material_document
+
+    doc = read_material_document(path)
+    law = doc.get("law")
+    if not isinstance(law, str):
+        raise ColonsimError(f"material file {path} has no law; pass a material.json of colonsim calibrate")
+    names = calibration_law(law).parameter_names
+    params = doc.get("parameters")
+    if not isinstance(params, dict) or any(n not in params for n in names) or doc.get("units", "Pa") != "Pa":
+        raise ColonsimError(f"material file {path} lacks the parameters {', '.join(names)} in Pa; regenerate it")
+    return law, params
+
+
+def cmd_material_export(args):
+    from colonsim.identification.cards import write_cards
+
+    law, params = _law_and_parameters(args.material)
+    out = args.out if args.out is not None else args.material.parent
+    for path in write_cards(args.format, law, params, out, args.density):
+        print(f"{path}")
+
+
+def check_export(args):
+    """Before a calibration: refuse --export with --per-specimen, or a format that cannot hold --law."""
+    from colonsim.errors import ColonsimError
+    from colonsim.identification.cards import check_formats
+
+    if not args.export:
+        return
+    if args.per_specimen:
+        raise ColonsimError("--export writes one material's cards; fit the mean curve, or export a specimen's "
+                            "material.json with colonsim material export")
+    if args.law is not None:
+        check_formats(args.export, args.law)
+
+
+def export_after(args):
+    """After a calibration: the cards of the material.json it wrote."""
+    from colonsim.identification.cards import write_cards
+
+    if args.export:
+        law, params = _law_and_parameters(args.out / "material.json")
+        paths = write_cards(args.export, law, params, args.out)
+        print("material cards: " + ", ".join(str(p) for p in paths))
 
 
 def wants_modes(args) -> bool:
@@ -40,5 +110,7 @@ def cmd_calibrate_modes(args):
                           stability_range=tuple(args.stability_range) if args.stability_range else None,
                           analytic=args.analytic, mesh=args.mesh, quick=args.quick, seed=args.seed,
                           displacement_unit=args.displacement_unit, force_unit=args.force_unit)
+    check_export(args)
     calibrate_modes(request, args.out)
+    export_after(args)
 
