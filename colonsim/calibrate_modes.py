@@ -106,7 +106,10 @@ def calibrate_modes(request: ModeRequest, out: Path) -> list:
             print("Ogden laws skipped: the clamped FE strip runs the invariant laws only (--analytic fits them)")
         results = {name: calibrate_joint(curves, name, **options) for name in laws}
         written = write_comparison(results, out)
-        shown = written["table"].drop(columns=["parameters"]).set_index("law")
+        modes = {f"r2_{c.name}": f"R2 {c.mode}" for c in curves}
+        shown = written["table"].set_index("law")[["drucker_stable", "first_unstable", *modes, "bic", "delta_bic"]]
+        if len(set(modes.values())) == len(modes):
+            shown = shown.rename(columns=modes)
         print(shown.to_string(float_format=lambda v: f"{v:.4g}"))
         print(f"chosen: {written['chosen']}, {written['reason']}")
         chosen = results[written["chosen"]]
