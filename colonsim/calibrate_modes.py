@@ -31,6 +31,8 @@ class ModeRequest:
     seed: int = 1
     displacement_unit: str | None = None
     force_unit: str | None = None
+    load_start: object = None
+    decimate: int | None = None
 
 
 def wants_modes(manifest, curve, mode) -> bool:
@@ -58,6 +60,41 @@ def _curves(request: ModeRequest):
     if request.mode is not None:
         raise ColonsimError("--mode goes with --curve; a mode manifest has its own mode column")
     return read_mode_manifest(request.manifest, request.stress_measure, request.displacement_unit, request.force_unit)
+
+
+def _clean(curves, request, out):
+    """Strips cleaned as :func:`colonsim.identification.cleanup.clean` says (the load start is a
+    displacement: strips only); stress-stretch curves decimated at evenly spaced stretches."""
+    from dataclasses import replace
+
+    import numpy as np
+
+    from colonsim.files import save_figure
+    from colonsim.identification.cleanup import clean_curves, figure
+    from colonsim.identification.stress_curves import from_strip
+
+    load_start = request.load_start * 1e-3 if isinstance(request.load_start, (int, float)) else request.load_start
+    strips = [c.strip for c in curves if c.strip is not None]
+    cleaned, notes, changed = clean_curves(strips, load_start, request.decimate)
+    by_name = {c.name: c for c in cleaned}
+    out_curves = []
+    for c in curves:
+        if c.strip is not None:
+            out_curves.append(from_strip(by_name[c.name], c.weight))
+        elif request.decimate is not None:
+            grid = np.linspace(c.stretch[0], c.max_stretch, request.decimate)
+            step = {"step": "decimation", "points_before": int(c.stretch.size), "points_after": request.decimate,
+                    "how": "linear interpolation at evenly spaced stretches"}
+            out_curves.append(replace(c, stretch=grid, stress=np.interp(grid, c.stretch, c.stress),
+                                      meta={**c.meta, "cleaning": [step]}))
+            notes.append(f"{c.name}: decimated to {request.decimate} evenly spaced stretches")
+        else:
+            out_curves.append(c)
+    for note in notes:
+        print(note, flush=True)
+    if changed:
+        save_figure(figure(changed), Path(out) / "cleaning.png")
+    return out_curves
 
 
 def _describe(r) -> str:
@@ -94,7 +131,7 @@ def calibrate_modes(request: ModeRequest, out: Path) -> list:
         raise ColonsimError(f"--compare-laws fits every law; drop --law {request.law}")
     law = request.law or "mooney_rivlin_3"
     calibration_law(law)
-    curves = _curves(request)
+    curves = _clean(_curves(request), request, out)
     strip_model = "fe" if (not request.analytic and any(c.strip is not None for c in curves)) else "closed-form"
     budget = (Budget.quick() if request.quick else Budget()) if strip_model == "fe" else None
     options = dict(residuals=request.residuals, budget=budget, seed=request.seed,

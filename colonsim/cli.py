@@ -79,7 +79,7 @@ def cmd_calibrate(args):
         thickness_mm=args.thickness, displacement_unit=args.displacement_unit, force_unit=args.force_unit,
         per_specimen=args.per_specimen, law=args.law, compare_laws=args.compare_laws, analytic=args.analytic,
         mesh=args.mesh, points=args.points, quick=args.quick, seed=args.seed, workers=args.workers,
-        show_progress=not args.no_progress, given_as="--{}")
+        show_progress=not args.no_progress, given_as="--{}", load_start=args.load_start, decimate=args.decimate)
     cli_material.check_export(args)
     calibrate(request, args.out)
     cli_material.export_after(args)

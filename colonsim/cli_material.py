@@ -23,8 +23,25 @@ def add_calibrate_options(parser):
     g.add_argument("--stability-range", type=finite_float, nargs=2, metavar=("LOW", "HIGH"),
                    help="stretches over which every fitted law is checked for Drucker stability "
                         "(default 0.5 to twice the largest tested stretch)")
+    c = parser.add_argument_group("clean-up (recorded in material.json)")
+    c.add_argument("--load-start", type=_load_start, default=None, metavar="detect|off|MM",
+                   help="where the load starts: detect (slack or preload found in the data), off (raw curve), or the "
+                        "displacement in mm; default: a slack region found is corrected and said so, a preload only reported")
+    c.add_argument("--decimate", type=int, default=None, metavar="N",
+                   help="resample every curve at N evenly spaced displacements (stretches) before fitting")
     parser.add_argument("--export", nargs="+", choices=FORMATS, metavar="FORMAT",
                         help=f"also write the fitted law as material cards: {', '.join(FORMATS)} (material_<format>.* in --out)")
+
+
+def _load_start(text):
+    import argparse
+
+    if text in ("detect", "off"):
+        return text
+    try:
+        return finite_float(text)
+    except argparse.ArgumentTypeError:
+        raise argparse.ArgumentTypeError(f"--load-start {text!r}: give detect, off or a displacement in mm") from None
 
 
 def add_parsers(sub):
@@ -109,7 +126,8 @@ def cmd_calibrate_modes(args):
                           law=args.law, compare_laws=args.compare_laws, residuals=args.residuals,
                           stability_range=tuple(args.stability_range) if args.stability_range else None,
                           analytic=args.analytic, mesh=args.mesh, quick=args.quick, seed=args.seed,
-                          displacement_unit=args.displacement_unit, force_unit=args.force_unit)
+                          displacement_unit=args.displacement_unit, force_unit=args.force_unit,
+                          load_start=args.load_start, decimate=args.decimate)
     check_export(args)
     calibrate_modes(request, args.out)
     export_after(args)

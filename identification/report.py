@@ -83,7 +83,7 @@ def material_document(result: CalibrationResult, level=0.95, selection=None) -> 
         "model_comparison": result.model_comparison,
         "specimen": {"name": result.curve.name, "length_mm": result.curve.length * 1e3,
                      "width_mm": result.curve.width * 1e3, "thickness_mm": result.curve.thickness * 1e3,
-                     **{k: v for k, v in result.curve.meta.items() if k in ("path", "averaged_specimens")}},
+                     **{k: v for k, v in result.curve.meta.items() if k in ("path", "averaged_specimens", "cleaning")}},
         "provenance": {"tool": "colonsim calibrate", **code_version(),
                        "date": _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds"),
                        **result.settings, "source_files": source_records(result.curve)},

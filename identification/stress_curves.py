@@ -189,7 +189,8 @@ def from_strip(curve: TensileCurve, weight=1.0) -> ModeCurve:
     return ModeCurve(curve.name, "uniaxial", 1.0 + curve.displacement[keep] / curve.length,
                      curve.force[keep] / (curve.width * curve.thickness), float(weight), strip=curve,
                      meta={"path": curve.meta.get("path"), "stress_measure": "nominal (force / undeformed section)",
-                           "converted": "from force-displacement with the specimen's geometry"})
+                           "converted": "from force-displacement with the specimen's geometry",
+                           "cleaning": curve.meta.get("cleaning")})
 
 
 def read_mode_manifest(path, stress_measure=None, displacement_unit=None, force_unit=None) -> list[ModeCurve]:
