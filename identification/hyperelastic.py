@@ -27,8 +27,8 @@ planar         ``l, 1, 1/l``                    pure shear: a wide short sheet, 
 =============  ===============================  ============================================
 
 A real planar specimen is only approximately in pure shear: near its free edges the width
-contracts, so the closed form holds for the centre of a specimen many times wider than long
-(docs/calibration.md says how wide).
+contracts, and the force falls short of the closed form by about 0.1 h / w at stretch 1.5 for a
+specimen of height h and width w (docs/calibration.md, benchmarks/bench_planar_aspect.py).
 """
 
 from __future__ import annotations
