@@ -131,6 +131,9 @@ def calibrate_modes(request: ModeRequest, out: Path) -> list:
         raise ColonsimError(f"--compare-laws fits every law; drop --law {request.law}")
     law = request.law or "mooney_rivlin_3"
     calibration_law(law)
+    if request.stability_range is not None and not (0 < request.stability_range[0] < 1 < request.stability_range[1]):
+        lo, hi = request.stability_range
+        raise ColonsimError(f"--stability-range {lo:g} {hi:g}: it must run from below 1 to above 1 (e.g. 0.5 4)")
     curves = _clean(_curves(request), request, out)
     strip_model = "fe" if (not request.analytic and any(c.strip is not None for c in curves)) else "closed-form"
     budget = (Budget.quick() if request.quick else Budget()) if strip_model == "fe" else None

@@ -21,8 +21,8 @@ def add_calibrate_options(parser):
                    help="joint-fit residuals per curve: relative (default; floor 10%% of the curve's peak) or "
                         "absolute in units of the curve's peak")
     g.add_argument("--stability-range", type=finite_float, nargs=2, metavar=("LOW", "HIGH"),
-                   help="stretches over which every fitted law is checked for Drucker stability "
-                        "(default 0.5 to twice the largest tested stretch)")
+                   help="stretches over which a multi-mode fit's laws are checked for Drucker stability "
+                        "(default 0.5 to twice the largest tested stretch; a strip fit always checks that default)")
     c = parser.add_argument_group("clean-up (recorded in material.json)")
     c.add_argument("--load-start", type=_load_start, default=None, metavar="detect|off|MM",
                    help="where the load starts: detect (slack or preload found in the data), off (raw curve), or the "

@@ -80,9 +80,13 @@ def modes_figure(results, title=None) -> Figure:
                 ax.plot(f["stretch"], f["stress_exp_Pa"] / 1e6, "o", mfc="none", c="k", label="test")
             q = r.per_curve[r.per_curve["mode"] == mode]
             label = f"{r.law}: R$^2$ {', '.join(f'{v:.4f}' for v in q['r2'])}"
-            dense = np.linspace(1.0, f["stretch"].max(), 200)
-            line, = ax.plot(dense, calibration_law(r.law).nominal_stress(mode, dense, r.parameters) / 1e6, "-",
-                            label=label, c=None if len(results) > 1 else _MODE_COLOURS[mode])
+            if r.fit.get("strip_model") == "fe":  # the clamped FE strip at its points, not the closed form
+                x, y = f["stretch"], f["stress_fit_Pa"] / 1e6
+                label += " (clamped FE)"
+            else:
+                x = np.linspace(1.0, f["stretch"].max(), 200)
+                y = calibration_law(r.law).nominal_stress(mode, x, r.parameters) / 1e6
+            line, = ax.plot(x, y, "-", label=label, c=None if len(results) > 1 else _MODE_COLOURS[mode])
             ax_r.plot(f["stretch"], (f["stress_exp_Pa"] - f["stress_fit_Pa"]) / 1e6, ".-", c=line.get_color())
         ax.set_title(mode, fontsize=10)
         ax.legend(fontsize=7)
