@@ -150,3 +150,16 @@ def test_bundled_colon_calibration_is_unchanged():
     assert np.allclose(r.parameters, BUNDLED_QUICK, rtol=1e-12)
     assert len(r.history) == 311 and set(r.history["stage"]) == {"initial", "sensitivity", "cma-es", "nelder-mead"}
     assert seconds < 5.0  # 0.9 s before and after on the shared 2-core machine
+
+
+def test_a_strip_enters_joint_fits_through_the_clamped_fe_model():
+    from colonsim.identification.joint import JointObjective
+    from colonsim.identification.stress_curves import from_strip
+
+    strip = from_strip(read_manifest(BUNDLED_MANIFEST)[0])
+    params = [652.01, 42835.25, 219120.3]
+    fe = JointObjective([strip], "mooney_rivlin_3", strip_model="fe", mesh=(4, 2)).predictions(params)[0]
+    closed = JointObjective([strip], "mooney_rivlin_3").predictions(params)[0]
+    assert np.all(fe > closed) and np.max(fe / closed - 1) < 0.05  # the clamp stiffens by a few %
+    with pytest.raises(ColonsimError, match="FE strip runs the invariant laws only"):
+        JointObjective([strip], "ogden_2", strip_model="fe")
