@@ -105,7 +105,8 @@ def _describe(r) -> str:
     lines = [f"{r.law}: joint fit of {len(r.curves)} curve(s), {r.fit['residuals']} residuals, "
              f"{r.fit['evaluations']} evaluations in {r.fit['wall_time_s']:.1f} s"]
     for i, (n, unit) in enumerate(zip(law.parameter_names, law.units)):
-        lines.append(f"  {n:>6} = {r.parameters[i]:14.6g} {unit:<2}  sd {sd[i]:.3g}   95% [{ci[i, 0]:.6g}, {ci[i, 1]:.6g}]")
+        shown = "-" if unit == "1" else unit  # Ogden's exponents are dimensionless
+        lines.append(f"  {n:>6} = {r.parameters[i]:14.6g} {shown:<2}  sd {sd[i]:.3g}   95% [{ci[i, 0]:.6g}, {ci[i, 1]:.6g}]")
     mu0, mu0_sd = r.mu0
     lines.append(f"  mu0 = {mu0:.6g} Pa, sd {mu0_sd:.3g}")
     for _, row in r.per_curve.iterrows():
