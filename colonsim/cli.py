@@ -11,7 +11,7 @@ import sys
 import warnings
 from pathlib import Path
 
-from colonsim import catalog, cli_surrogate, cli_sweep
+from colonsim import catalog, cli_material, cli_surrogate, cli_sweep
 from colonsim.errors import ColonsimError, ColonsimWarning
 from colonsim.options import finite_float, output_folder, positive_int
 from colonsim.insertion.case.run_budget import DEFAULT_MAX_STEPS
@@ -49,7 +49,7 @@ def _add_calibrate(sub):
     fit.add_argument("--per-specimen", action="store_true",
                      help="fit every specimen separately and report the population mean and spread "
                           "(default: fit the mean curve of all specimens, the source's way)")
-    fit.add_argument("--law", help="mooney_rivlin_3 (default), mooney_rivlin_2, neo_hookean, yeoh")
+    fit.add_argument("--law", help="mooney_rivlin_3 (default), mooney_rivlin_2, neo_hookean, yeoh; ogden_1..3 in multi-mode fits")
     fit.add_argument("--compare-laws", action="store_true",
                      help="fit every law (all of them run in the insertion solver), write laws.csv and laws.png, and material.json "
                           "for the law BIC chooses")
@@ -61,6 +61,7 @@ def _add_calibrate(sub):
                      help="reduced budget (40 designs, 100 CMA-ES, 160 Nelder-Mead evaluations) instead of 100/300/300")
     fit.add_argument("--seed", type=int, default=1, help="seed of the Latin hypercube and CMA-ES (default 1)")
     fit.add_argument("--workers", type=int, default=2, help="processes for --per-specimen (default 2)")
+    cli_material.add_calibrate_options(p)
     p.add_argument("--out", type=output_folder, default="colonsim_results/calibration",
                    help="output folder (default colonsim_results/calibration)")
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
@@ -70,13 +71,18 @@ def _add_calibrate(sub):
 def cmd_calibrate(args):
     from colonsim.workflows import CalibrationRequest, calibrate
 
+    if cli_material.wants_modes(args):
+        return cli_material.cmd_calibrate_modes(args)
+
     request = CalibrationRequest(
         manifest=args.manifest, curve=args.curve, length_mm=args.length, width_mm=args.width,
         thickness_mm=args.thickness, displacement_unit=args.displacement_unit, force_unit=args.force_unit,
         per_specimen=args.per_specimen, law=args.law, compare_laws=args.compare_laws, analytic=args.analytic,
         mesh=args.mesh, points=args.points, quick=args.quick, seed=args.seed, workers=args.workers,
-        show_progress=not args.no_progress, given_as="--{}")
+        show_progress=not args.no_progress, given_as="--{}", load_start=args.load_start, decimate=args.decimate)
+    cli_material.check_export(args)
     calibrate(request, args.out)
+    cli_material.export_after(args)
 
 
 def cmd_demo(args):
@@ -173,6 +179,7 @@ def build_parser():
     sub = parser.add_subparsers(dest="command", required=True)
     _add_calibrate(sub)
     _add_insert(sub)
+    cli_material.add_parsers(sub)
     cli_sweep.add_parser(sub)
     cli_surrogate.add_parsers(sub)
     demo = sub.add_parser("demo", help="run the workflows on the bundled data (a few minutes on 2 cores)")

@@ -50,6 +50,9 @@ class CalibrationRequest:
     seed: int = 1
     workers: int = 2
     show_progress: bool = True
+    # cleaning (colonsim.identification.cleanup): None, "detect", "off" or the load start in mm; points
+    load_start: object = None
+    decimate: int | None = None
     # how errors name the geometry options ("--{}": the command line's --length ...)
     given_as: str = "{}_mm"
 
@@ -87,6 +90,20 @@ def _load_curves(request):
         if notes:
             print(f"{c.name}: {'; '.join(notes)}", flush=True)
     return curves
+
+
+def _clean(curves, request, out):
+    """The curves cleaned as asked (slack found is always corrected); notes printed, figure written."""
+    from colonsim.files import save_figure
+    from colonsim.identification.cleanup import clean_curves, figure
+
+    load_start = request.load_start * 1e-3 if isinstance(request.load_start, (int, float)) else request.load_start
+    cleaned, notes, changed = clean_curves(curves, load_start, request.decimate)
+    for note in notes:
+        print(note, flush=True)
+    if changed:
+        save_figure(figure(changed), Path(out) / "cleaning.png")
+    return cleaned
 
 
 class _Progress:
@@ -153,10 +170,13 @@ def _format_result(r) -> str:
 def _print_warnings(results):
     from colonsim.identification.diagnostics import misfit_warning
 
+    from colonsim.identification.report import strip_stability
+
     for r in results:
-        warning = misfit_warning(r)
-        if warning:
-            print(f"colonsim: warning: {warning}", file=sys.stderr, flush=True)
+        unstable = strip_stability(r).warning()
+        for warning in (misfit_warning(r), unstable and f"{r.curve.name}: {unstable}"):
+            if warning:
+                print(f"colonsim: warning: {warning}", file=sys.stderr, flush=True)
 
 
 def calibrate(request: CalibrationRequest, out: Path) -> list:
@@ -179,7 +199,7 @@ def calibrate(request: CalibrationRequest, out: Path) -> list:
         raise ColonsimError(f"--points {request.points} is too few to fit 3 parameters; use at least 5 (default 20)")
     if request.workers < 1:
         raise ColonsimError(f"--workers {request.workers}; give at least 1")
-    curves = _load_curves(request)
+    curves = _clean(_load_curves(request), request, out)
     budget = Budget.quick() if request.quick else Budget()
     options = dict(law=law, analytic=request.analytic, budget=budget, seed=request.seed, n_points=request.points)
     if not request.analytic:

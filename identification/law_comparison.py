@@ -1,7 +1,8 @@
 """Fitting every hyperelastic law to one curve, and choosing one by BIC.
 
 Each law of :data:`colonsim.laws.LAWS` (all of them run in the insertion solver) goes through the same pipeline; the laws are
-ranked by the Bayesian information criterion of their least-squares fit on the simulation
+ranked by the Bayesian information criterion, Drucker-stable laws first (:mod:`colonsim.identification.stability`, along
+the three test modes from 0.5 to twice the strip's largest stretch), of their least-squares fit on the simulation
 points (Gaussian errors of unknown variance: ``n ln(RSS / n) + k ln n``, AIC with ``2 k``). A
 law with more parameters must lower the residual enough to pay for them, so a simpler law that
 fits as well wins. Differences are read on Kass and Raftery's scale (JASA 90, 1995).
@@ -24,7 +25,7 @@ from matplotlib.figure import Figure
 
 from colonsim.files import save_figure, write_csv, write_json
 from colonsim.identification.diagnostics import parameters_at_bounds, shear_modulus
-from colonsim.identification.report import material_document, write_calibration
+from colonsim.identification.report import material_document, strip_stability, write_calibration
 from colonsim.laws import LAWS
 
 # Kass & Raftery's reading of a BIC difference (upper bound of each band).
@@ -57,7 +58,7 @@ class LawComparison:
     def selection(self) -> dict:
         """The ``law_selection`` section of the chosen law's ``material.json``."""
         t = self.table
-        return {"criterion": "BIC (lowest wins): n ln(RSS/n) + k ln n on the simulation points",
+        return {"criterion": "Drucker-stable laws first, then BIC (lowest wins): n ln(RSS/n) + k ln n on the simulation points",
                 "chosen": self.chosen, "reason": self.reason,
                 "bic": dict(zip(t["law"], t["bic"])), "aic": dict(zip(t["law"], t["aic"])),
                 "table": "laws.csv"}
@@ -71,14 +72,21 @@ def compare_laws(calibrate_law, laws=tuple(LAWS)) -> LawComparison:
         n, k = r.fit["n_points"], len(r.names)
         aic, bic = information_criteria(r.fit["e1_N2"], n, k)
         mu0, mu0_sd = shear_modulus(r)
-        rows.append({"law": law, "n_parameters": k, **{f"{p}_Pa": v for p, v in r.parameter_dict.items()},
+        first = strip_stability(r).first()
+        rows.append({"law": law, "n_parameters": k, "drucker_stable": first is None,
+                     "first_unstable": "" if first is None else f"{first[0]} {first[1]} from {first[2]:.3g}",
+                     **{f"{p}_Pa": v for p, v in r.parameter_dict.items()},
                      "rms_N": r.fit["rms_N"], "rms_over_noise": r.fit["rms_over_noise"], "aic": aic, "bic": bic,
                      "mu0_Pa": mu0, "mu0_sd_Pa": mu0_sd, "note": "; ".join(parameters_at_bounds(r))})
     table = pd.DataFrame(rows)
     table["delta_bic"] = table["bic"] - table["bic"].min()
-    order = table.sort_values(["bic", "n_parameters"]).reset_index(drop=True)
+    order = table.sort_values(["drucker_stable", "bic", "n_parameters"], ascending=[False, True, True]).reset_index(drop=True)
     chosen = order.loc[0, "law"]
     reason = f"lowest BIC ({order.loc[0, 'bic']:.1f})"
+    unstable = order.loc[~order["drucker_stable"], "law"].tolist()
+    if unstable and order.loc[0, "drucker_stable"]:
+        reason += f" among the Drucker-stable laws (passed over: {', '.join(unstable)})"
+        order = order[order["drucker_stable"]].reset_index(drop=True)
     if len(order) > 1:
         d = order.loc[1, "delta_bic"]
         reason += f"; next {order.loc[1, 'law']} at delta BIC {d:.1f} ({evidence(d)} evidence for {chosen})"
@@ -88,7 +96,7 @@ def compare_laws(calibrate_law, laws=tuple(LAWS)) -> LawComparison:
     table["chosen"] = table["law"] == chosen
     table.loc[table["chosen"], "note"] = "; ".join(filter(None, [reason, *table.loc[table["chosen"], "note"]]))
     parameter_columns = [f"{p}_Pa" for law in LAWS.values() for p in law.parameter_names]
-    columns = ["law", "chosen", "n_parameters", *dict.fromkeys(c for c in parameter_columns if c in table),
+    columns = ["law", "chosen", "n_parameters", "drucker_stable", "first_unstable", *dict.fromkeys(c for c in parameter_columns if c in table),
                "rms_N", "rms_over_noise", "aic", "bic", "delta_bic", "mu0_Pa", "mu0_sd_Pa", "note"]
     return LawComparison(results, table[columns], chosen, reason)
 

@@ -1,33 +1,26 @@
-"""The identification pipeline of docs/model.md: sensitivity study -> CMA-ES -> Nelder-Mead.
+"""The identification pipeline of docs/model.md on one strip curve: sensitivity study -> CMA-ES -> Nelder-Mead.
 
-1. Sensitivity study: a Latin hypercube over the parameter bounds, every design evaluated with
-   the force model and ranked by the objective e1; each parameter's sensitivity is reported as
-   the Spearman rank correlation with log(e1) and with the simulated force at 50 % and 100 % of
-   the displacement range.
-2. Global search: CMA-ES (package ``cma``) in bound-normalised coordinates whose first
-   population holds the 10 best designs of step 1 (``inject(..., force=True)``), driven by
-   ask/tell so evaluations could run anywhere.
-3. Local search: Nelder-Mead (scipy) from the best global design, within the bounds.
-
-Every evaluation is recorded (stage, parameters, e1, wall time) and the whole run is seeded.
+The search itself (Latin hypercube, CMA-ES seeded with the 10 best designs, Nelder-Mead polish,
+every evaluation recorded, seeded) is :mod:`colonsim.identification.search`; here it minimises
+e1 = sum (F_exp - F_sim)^2 of one specimen, whose sensitivity probes are the simulated force at
+50 % and 100 % of the displacement range. Around it: the default bounds, the magnitude check of
+the curve, the fit's quality, uncertainty and the clamped-FE / closed-form model comparison.
 """
 
 from __future__ import annotations
 
-import time
 from dataclasses import dataclass, field
 
-import cma
 import numpy as np
 import pandas as pd
-from scipy import optimize, stats
-from scipy.stats import qmc
+from scipy import optimize
 
 from colonsim.errors import ColonsimError
 from colonsim.identification.diagnostics import fit_against_noise, shear_modulus_weights
 from colonsim.identification.objective import CurveObjective, make_model
 from colonsim.identification.specimen import FEConvergenceError
 from colonsim.identification.testdata import TensileCurve
+from colonsim.identification.search import Budget, SearchProblem, search
 from colonsim.identification.uniaxial import HomogeneousStripModel
 from colonsim.identification.uncertainty import FitUncertainty, fit_uncertainty
 
@@ -86,27 +79,6 @@ def check_force_magnitude(objective: CurveObjective, upper):
 
 
 @dataclass
-class Budget:
-    """Evaluation budget of each stage (defaults: the full pipeline).
-
-    CMA-ES locates the basin; the Nelder-Mead polish does most of the last two decades of e1 and
-    gets the larger share (measured on the bundled data: 150 simplex evaluations stopped short
-    of convergence, 300 do not).
-    """
-
-    designs: int = 100
-    cma_popsize: int = 10
-    cma_max_evaluations: int = 300
-    cma_sigma0: float = 0.15
-    nm_max_evaluations: int = 300
-
-    @classmethod
-    def quick(cls):
-        """A reduced budget for demos and tests (stated as such in results)."""
-        return cls(designs=40, cma_popsize=10, cma_max_evaluations=100, nm_max_evaluations=160)
-
-
-@dataclass
 class CalibrationResult:
     """Outcome of :func:`calibrate` (parameters in Pa, forces in N)."""
 
@@ -126,55 +98,6 @@ class CalibrationResult:
     @property
     def parameter_dict(self):
         return dict(zip(self.names, self.parameters.tolist()))
-
-
-class _Recorder:
-    """Evaluates the objective in normalised coordinates and records every evaluation."""
-
-    def __init__(self, objective, lower, upper, names, progress=None):
-        self.objective, self.lower, self.upper, self.names = objective, lower, upper, names
-        self.rows = []
-        self.progress = progress
-        self.stage = ""
-
-    def to_params(self, x):
-        return self.lower + np.clip(np.asarray(x, dtype=float), 0.0, 1.0) * (self.upper - self.lower)
-
-    def __call__(self, x):
-        params = self.to_params(x)
-        t0 = time.perf_counter()
-        try:
-            forces = self.objective.simulate(params)
-            r = self.objective.force_exp - forces
-            value = float(r @ r)
-            ok = np.isfinite(value)
-        except FEConvergenceError:  # a failed model evaluation is recorded, never fatal
-            forces, value, ok = None, self.objective.failure_value, False
-        if not ok:
-            value = self.objective.failure_value
-        row = {"evaluation": len(self.rows), "stage": self.stage, **dict(zip(self.names, params)),
-               "e1": value, "ok": ok, "seconds": time.perf_counter() - t0}
-        if forces is not None:
-            n = forces.size
-            row["F_mid"] = float(forces[n // 2 - 1])
-            row["F_end"] = float(forces[-1])
-        self.rows.append(row)
-        if self.progress is not None:
-            self.progress(self.stage, len(self.rows), value)
-        return value
-
-    def best(self, stage=None):
-        rows = [r for r in self.rows if stage is None or r["stage"] == stage]
-        return min(rows, key=lambda r: r["e1"])
-
-
-def sensitivity_measures(designs: pd.DataFrame, names) -> pd.DataFrame:
-    """Spearman rank correlation of each parameter with log(e1) and the simulated forces."""
-    ok = designs[designs["ok"]]
-    out = {}
-    for target, column in (("log_e1", np.log(ok["e1"].clip(lower=1e-300))), ("F_mid", ok["F_mid"]), ("F_end", ok["F_end"])):
-        out[f"spearman_{target}"] = [stats.spearmanr(ok[n], column).statistic for n in names]
-    return pd.DataFrame(out, index=list(names))
 
 
 def calibrate(objective: CurveObjective, bounds=None, initial=None, budget: Budget | None = None,
@@ -200,68 +123,22 @@ def calibrate(objective: CurveObjective, bounds=None, initial=None, budget: Budg
     lower = np.array([bounds[n][0] for n in names], dtype=float)
     upper = np.array([bounds[n][1] for n in names], dtype=float)
     check_force_magnitude(objective, upper)
-    rec = _Recorder(objective, lower, upper, names, progress)
-    t_start = time.perf_counter()
-
-    rec.stage = "initial"
-    x_init = (np.array([initial[n] for n in names]) - lower) / (upper - lower)
-    e_init = rec(x_init)
-
-    # 1. Sensitivity study on a Latin hypercube.
-    rec.stage = "sensitivity"
-    lhs = qmc.LatinHypercube(d=len(names), seed=seed).random(budget.designs)
-    e_lhs = np.array([rec(x) for x in lhs])
-    designs = pd.DataFrame(rec.rows[1:])
-    order = np.argsort(e_lhs)
-    top = lhs[order[:10]]
-
-    # 2. CMA-ES with the 10 best designs in its first population.
-    rec.stage = "cma-es"
-    es = cma.CMAEvolutionStrategy(top[0], budget.cma_sigma0, {
-        # BoundPenalty keeps the injected designs exactly as they are (BoundTransform would
-        # remap those within 5 % of a bound); evaluations clip to the box.
-        "bounds": [0.0, 1.0], "BoundaryHandler": cma.BoundPenalty, "popsize": max(budget.cma_popsize, len(top)), "seed": seed,
-        "maxfevals": budget.cma_max_evaluations, "verbose": -9, "tolfun": 1e-12, "tolx": 1e-6,
-    })
-    es.inject(list(top), force=True)
-    while not es.stop():
-        X = es.ask()
-        es.tell(X, [rec(x) for x in X])
-    best_global = rec.best()
-    x_global = (np.array([best_global[n] for n in names]) - lower) / (upper - lower)
-
-    # 3. Nelder-Mead polish from the best design so far.
-    rec.stage = "nelder-mead"
-    simplex = np.vstack([x_global] + [np.clip(x_global + 0.02 * e, 0.0, 1.0) if x_global @ e < 0.98
-                                      else x_global - 0.02 * e for e in np.eye(len(names))])
-    nm = optimize.minimize(rec, x_global, method="Nelder-Mead", bounds=[(0.0, 1.0)] * len(names), options={
-        "maxfev": budget.nm_max_evaluations, "xatol": 1e-5, "fatol": 1e-9, "initial_simplex": simplex})
-    best = rec.best()
-    theta = np.array([best[n] for n in names])
-    wall = time.perf_counter() - t_start
-
-    history = pd.DataFrame(rec.rows)
-    stages = {
-        "initial": {"e1": e_init, "parameters": dict(zip(names, (lower + x_init * (upper - lower)).tolist()))},
-        "sensitivity": {"e1": float(e_lhs.min()), "evaluations": int(budget.designs)},
-        "cma-es": {"e1": float(best_global["e1"]), "evaluations": int((history["stage"] == "cma-es").sum()),
-                   "iterations": int(es.countiter), "stop": {k: str(v) for k, v in es.stop().items()}},
-        "nelder-mead": {"e1": float(best["e1"]), "evaluations": int((history["stage"] == "nelder-mead").sum()),
-                        "iterations": int(nm.nit), "message": str(nm.message)},
-    }
+    problem = SearchProblem(objective.simulate, objective.force_exp, objective.failure_value, (FEConvergenceError,))
+    outcome = search(problem, names, bounds, initial, budget, seed, progress)
+    theta, wall = outcome.theta, outcome.wall_time_s
     unc = fit_uncertainty(objective.simulate, objective.force_exp, theta, names, upper - lower)
     f_fit = objective.simulate(theta)
     resid = objective.force_exp - f_fit
     ss_tot = float(((objective.force_exp - objective.force_exp.mean()) ** 2).sum())
     fit = {"e1_N2": float(resid @ resid), "rms_N": float(np.sqrt(np.mean(resid**2))),
            "max_abs_N": float(np.abs(resid).max()), "r2": 1.0 - float(resid @ resid) / ss_tot if ss_tot > 0 else None,
-           "n_points": int(resid.size), "n_parameters": len(names), "wall_time_s": wall, "evaluations": len(rec.rows),
+           "n_points": int(resid.size), "n_parameters": len(names), "wall_time_s": wall, "evaluations": outcome.evaluations,
            **fit_against_noise(objective.curve, objective.displacement, resid, len(names))}
     fitted = pd.DataFrame({"displacement_mm": objective.displacement * 1e3, "force_exp_N": objective.force_exp,
                            "force_fit_N": f_fit})
     settings = {"seed": seed, "budget": budget.__dict__.copy(), "bounds_Pa": {n: list(bounds[n]) for n in names},
                 "initial_Pa": dict(initial)}
-    return CalibrationResult(names, theta, history, stages, sensitivity_measures(designs, names), unc, fit,
+    return CalibrationResult(names, theta, outcome.history, outcome.stages, outcome.sensitivity, unc, fit,
                              fitted, objective.curve, objective.model.describe(),
                              compare_models(objective, theta, lower, upper), settings)
 

@@ -24,6 +24,8 @@ from matplotlib.figure import Figure
 from colonsim.files import save_figure, write_csv, write_json
 from colonsim.provenance import code_version
 from colonsim.identification.diagnostics import identification_words, misfit_warning, shear_modulus
+from colonsim.identification.hyperelastic import calibration_law
+from colonsim.identification.stability import StabilityCheck, check_stability, default_range
 from colonsim.laws import get_law
 from colonsim.identification.pipeline import CalibrationResult
 from colonsim.identification.testdata import source_records
@@ -48,12 +50,20 @@ def small_strain(result: CalibrationResult) -> dict:
             "model_form": model_form}
 
 
+def strip_stability(result: CalibrationResult) -> StabilityCheck:
+    """Drucker stability of a strip fit along the three modes, from 0.5 to twice the strip's largest stretch."""
+    c = result.curve
+    return check_stability(calibration_law(result.model["law"]), result.parameters,
+                           default_range(1.0 + c.max_displacement / c.length))
+
+
 def material_document(result: CalibrationResult, level=0.95, selection=None) -> dict:
     """The ``material.json`` document of one calibration (read by :mod:`colonsim.insertion.engine.material`);
     ``selection`` records why this law was chosen when several were compared."""
     law = get_law(result.model["law"])
     unc = result.uncertainty.to_dict(level)
     warning = misfit_warning(result)
+    stability = strip_stability(result)
     document = {
         "format": MATERIAL_FORMAT,
         "law": law.name,
@@ -62,7 +72,8 @@ def material_document(result: CalibrationResult, level=0.95, selection=None) -> 
         "units": "Pa",
         "parameters": result.parameter_dict,
         "small_strain": small_strain(result),
-        "warnings": [warning] if warning else [],
+        "warnings": [w for w in (warning, stability.warning()) if w],
+        "stability": stability.to_dict(),
         "uncertainty": {k: unc[k] for k in unc if k not in ("correlation", "covariance")},
         "correlation": {"names": list(result.names), "matrix": unc["correlation"]},
         "covariance_Pa2": unc["covariance"],
@@ -72,7 +83,7 @@ def material_document(result: CalibrationResult, level=0.95, selection=None) -> 
         "model_comparison": result.model_comparison,
         "specimen": {"name": result.curve.name, "length_mm": result.curve.length * 1e3,
                      "width_mm": result.curve.width * 1e3, "thickness_mm": result.curve.thickness * 1e3,
-                     **{k: v for k, v in result.curve.meta.items() if k in ("path", "averaged_specimens")}},
+                     **{k: v for k, v in result.curve.meta.items() if k in ("path", "averaged_specimens", "cleaning")}},
         "provenance": {"tool": "colonsim calibrate", **code_version(),
                        "date": _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds"),
                        **result.settings, "source_files": source_records(result.curve)},

@@ -302,5 +302,5 @@ def source_records(curve) -> list[dict]:
     geometry came from, units, layout and preamble (one record per file of a mean curve)."""
     if "sources" in curve.meta:
         return list(curve.meta["sources"])
-    keys = ("path", "geometry_from", "units", "layout", "preamble")
+    keys = ("path", "geometry_from", "units", "layout", "preamble", "cleaning")
     return [{"specimen": curve.name, **{k: curve.meta[k] for k in keys if k in curve.meta}}] if "path" in curve.meta else []

@@ -36,9 +36,10 @@ LAYERS = {
     "colonsim.identification.pipeline": WORKFLOW, "colonsim.identification.population": WORKFLOW,
     "colonsim.identification.report": WORKFLOW, "colonsim.identification.law_comparison": WORKFLOW,
     "colonsim.identification.verification": WORKFLOW, "colonsim.identification.synthetic_data": WORKFLOW,
+    "colonsim.identification.joint": WORKFLOW, "colonsim.identification.joint_report": WORKFLOW,
     "colonsim.surrogate": WORKFLOW,
     "colonsim.workflows": TOP, "colonsim.cli": TOP, "colonsim.cli_sweep": TOP, "colonsim.cli_surrogate": TOP,
-    "colonsim.options": TOP, "colonsim.demo": TOP,
+    "colonsim.options": TOP, "colonsim.demo": TOP, "colonsim.cli_material": TOP, "colonsim.calibrate_modes": TOP,
 }
 LAYER_NAMES = ("ground", "physics", "anatomy", "case", "workflow", "top")
 MAX_LINES = 450

@@ -47,7 +47,8 @@ def test_one_top_level_package(wheel_names):
 def test_package_data_ships(wheel_names):
     for name in ("colonsim/data/material_reference.json", "colonsim/data/tensile/manifest.csv",
                  "colonsim/data/tensile/specimen_01.csv", "colonsim/data/tensile/ground_truth.json",
-                 "colonsim/data/anatomy/sigmoid_loop.csv"):
+                 "colonsim/data/anatomy/sigmoid_loop.csv", "colonsim/data/treloar/manifest.csv",
+                 "colonsim/data/treloar/planar.csv"):
         assert name in wheel_names
     for name in ("colonsim/insertion/engine/solver.py", "colonsim/identification/pipeline.py",
                  "colonsim/surrogate/model.py", "colonsim/insertion/study/sweep.py"):

@@ -130,6 +130,9 @@ def load_material(path):
     path = Path(path)
     data = read_material_document(path)
     law = data.get("law")
+    if isinstance(law, str) and law.startswith("ogden_"):
+        raise ColonsimError(f"material file {path} has law {law!r}: the insertion shell runs the invariant laws only "
+                            f"({', '.join(LAWS)}), not Ogden yet; calibrate one of those for an insertion.")
     if not isinstance(law, str) or law not in LAWS:
         raise ColonsimError(
             f"material file {path} has law {law!r}; use one of {', '.join(LAWS)} (the laws the calibration fits)."
