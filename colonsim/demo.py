@@ -4,7 +4,8 @@
 2. RSJ insertions of UTC, PDC and SDC (D = 36 mm, mu = 0) with the material just calibrated;
 3. a small sweep: RSJ x 3 scopes x D 23/36 mm x mu 0/0.1 (12 runs on local processes);
 4. a surrogate fitted on that sweep (leave-one-out cross-validation reported);
-5. a scope recommendation for two contrasting patients.
+5. a scope recommendation for two contrasting patients, by the largest colon deformation over the
+   run (the pain proxy, docs/surrogate.md; ``--target final_deformation_cm`` for the end value).
 
 Everything goes to one folder (default ``colonsim_demo/``); ``report.md`` there lists what was
 run and where each file is. Rerunning into the same folder skips the sweep runs already done.
@@ -16,6 +17,7 @@ import time
 from dataclasses import dataclass
 from pathlib import Path
 
+from colonsim.catalog import PAIN_PROXY
 from colonsim.workflows import available_cores
 
 DEMO_SWEEP = """
@@ -39,7 +41,8 @@ PATIENTS = (
     {"label": "young African patient", "age": "young", "region": "african"},
     {"label": "older European patient (diverticular disease)", "age": "older", "region": "european"},
 )
-SURROGATE_TARGETS = ("final_deformation_cm", "point_A_cm", "peak_contact_force_N", "max_wall_stretch")
+SURROGATE_TARGETS = ("max_deformation_cm", "final_deformation_cm", "point_A_cm", "peak_contact_force_N",
+                     "max_wall_stretch")
 
 
 def _section(text):
@@ -83,8 +86,8 @@ def sweep_step(material: Path, element_size: float, out: Path, workers: int, sho
     rate = f" ({report.runs_per_hour:.0f} runs/hour)" if report.ran else ""
     print(f"{report.skipped} already done, {report.ran} run in {report.wall_time_s:.0f} s{rate}: {report.ok} ok, "
           f"{report.failed} failed -> {out / 'results.parquet'}")
-    cols = ["scope", "diameter_mm", "friction", "status", "point_A_cm", "point_C_cm", "final_deformation_cm",
-            "peak_contact_force_N", "wall_time_s"]
+    cols = ["scope", "diameter_mm", "friction", "status", "point_A_cm", "point_C_cm", "max_deformation_cm",
+            "final_deformation_cm", "peak_contact_force_N", "wall_time_s"]
     table = report.table.sort_values(["diameter_mm", "friction", "scope_diameter_mm"])[cols]
     print(table.to_string(index=False, float_format=lambda v: f"{v:.3g}"))
     return report
@@ -110,7 +113,7 @@ def surrogate_step(results: Path, out: Path):
     return model, json_path, figures
 
 
-def recommend_step(model, out: Path):
+def recommend_step(model, out: Path, target):
     from colonsim.files import write_json
     from colonsim.surrogate.patients import describe_patient, patient_inputs
     from colonsim.surrogate.recommend import format_recommendation, recommend
@@ -119,7 +122,7 @@ def recommend_step(model, out: Path):
     recs = []
     for p in PATIENTS:
         inputs = patient_inputs("rsj", age=p["age"], region=p["region"])
-        rec = recommend(model, "rsj", inputs)
+        rec = recommend(model, "rsj", inputs, target=target)
         rec["patient"] = {"label": p["label"], "age": p["age"], "region": p["region"],
                           "mapping": describe_patient("rsj", age=p["age"], region=p["region"])}
         recs.append(rec)
@@ -157,8 +160,8 @@ def write_report(out: Path, calibration, insertions, sweep, model, recs, seconds
               f"{sweep.total} runs, {int((sweep.table['status'] == 'ok').sum())} ok. "
               "Table: `sweep/results.parquet`; time series: `sweep/runs/<key>/`.", "",
               frame_table(sweep.table.sort_values(["diameter_mm", "friction", "scope_diameter_mm"])[
-                  ["scope", "diameter_mm", "friction", "point_A_cm", "point_C_cm", "final_deformation_cm",
-                   "peak_contact_force_N"]], _cell), "",
+                  ["scope", "diameter_mm", "friction", "point_A_cm", "point_C_cm", "max_deformation_cm",
+                   "final_deformation_cm", "peak_contact_force_N"]], _cell), "",
               "## 4. Surrogate (`surrogate.json` + `surrogate.npz`)", "", "```", model.report(), "```", "",
               "![surrogate vs colon diameter](surrogate_vs_diameter_mm.png)", "",
               "## 5. Recommendations (`recommendations.json`)", ""]
@@ -195,12 +198,14 @@ def print_summary(calibration, insertions, model, recs):
 
 @dataclass(frozen=True)
 class DemoOptions:
-    """Where the demo writes, its wall mesh (mm), sweep processes (None: up to 2 cores) and bars."""
+    """Where the demo writes, its wall mesh (mm), sweep processes (None: up to 2 cores), bars, and
+    the deformation the summary and the recommendations rank by."""
 
     out: Path = Path("colonsim_demo")
     element_size_mm: float = 3.0
     workers: int | None = None
     show_progress: bool = True
+    target: str = PAIN_PROXY
 
 
 def run_demo(options: DemoOptions):
@@ -221,10 +226,10 @@ def run_demo(options: DemoOptions):
     seconds["sweep"] = time.perf_counter() - t
     t = time.perf_counter()
     model, _, _ = surrogate_step(out / "sweep" / "results.parquet", out)
-    recs = recommend_step(model, out)
+    recs = recommend_step(model, out, options.target)
     seconds["surrogate and recommendations"] = time.perf_counter() - t
     report = write_report(out, calibration, insertions, sweep, model, recs, seconds, options.element_size_mm)
-    print_summary(calibration, insertions, model, recs)
+    print_summary(calibration, insertions, model, recs, options.target)
     print(f"\ndemo finished in {time.perf_counter() - t0:.0f} s; report: {report}; every file in {out}/")
     print("Next: `colonsim sweep --preset thesis` runs the source's 39 insertions; `colonsim surrogate fit` and "
           "`colonsim recommend` work on its results.parquet the same way.")

@@ -18,19 +18,44 @@ The interval is that of a new simulation result (trend + scatter), the quantity 
 from __future__ import annotations
 
 import numpy as np
+from scipy.stats import chi2
+
 from colonsim.errors import ColonsimError
 from colonsim.surrogate.likelihood import inverse_from_cholesky
 
 Z95 = 1.959963984540054
+MIN_CHECKED_RUNS = 10  # fewer: the model cannot vouch for its error (measured, docs/surrogate.md "Too few runs")
 
 
 def metrics(y, mean, std):
-    """RMSE, maximum absolute error, coverage of mean +- 1.96 std, and Q^2 = 1 - SSE / SS."""
+    """RMSE, maximum absolute error, coverage of mean +- 1.96 std, Q^2 = 1 - SSE / SS, and the root
+    mean square of the standardized errors ``(y - mean) / std`` (about 1 when the sd is right)."""
     err = np.asarray(mean) - np.asarray(y)
     ss = float(np.sum((y - np.mean(y)) ** 2))
     return {"n": int(len(y)), "rmse": float(np.sqrt(np.mean(err**2))), "max_abs_error": float(np.max(np.abs(err))),
             "coverage_95": float(np.mean(np.abs(err) <= Z95 * np.asarray(std))),
-            "mean_std": float(np.mean(std)), "q2": float(1.0 - np.sum(err**2) / ss) if ss > 0 else None}
+            "mean_std": float(np.mean(std)), "q2": float(1.0 - np.sum(err**2) / ss) if ss > 0 else None,
+            "z_rms": float(np.sqrt(np.mean((err / np.asarray(std)) ** 2)))}
+
+
+def error_unknown(cv: dict) -> str | None:
+    """Why the model cannot state its error (too few runs to check it, or cross-validated errors
+    larger than the sd it states), or None when it can.
+
+    Its intervals are vouched for when at least :data:`MIN_CHECKED_RUNS` runs were each predicted
+    without themselves and their standardized errors are consistent with the stated sd: the sum
+    of their squares below the 95th percentile of a chi-square with as many degrees of freedom (a
+    model whose sd is right exceeds it one time in twenty). docs/surrogate.md, "Too few runs"."""
+    n, z_rms = int(cv["n"]), cv.get("z_rms")
+    if z_rms is None:
+        return "its error was not cross-checked (a model of an older colonsim); refit it"
+    if n < MIN_CHECKED_RUNS:
+        return f"too few runs to know its error ({n} < {MIN_CHECKED_RUNS})"
+    limit = float(np.sqrt(chi2.ppf(0.95, n) / n))
+    if z_rms > limit:
+        return (f"too few runs to know its error: its cross-validated errors are {z_rms:.1f} times the sd it states "
+                f"(at most {limit:.2f} with {n} runs)")
+    return None
 
 
 def loo_predictions(gp):
