@@ -181,8 +181,8 @@ class SweepSurrogate:
         """Why the model of ``segment`` and ``target`` cannot state its error (too few runs to check
         it), or None when its sd, intervals and probabilities are vouched for
         (:func:`colonsim.surrogate.validation.error_unknown`)."""
-        domain, _ = self.model_for(segment, target)
-        return error_unknown(self.cv_[domain.segment][target])
+        domain, gp = self.model_for(segment, target)
+        return error_unknown(self.cv_[domain.segment][target], gp)
 
     def query(self, segment, values: dict) -> dict:
         """``values`` with scope names (key ``scope``) turned into ``scope_diameter_mm``; a diameter
@@ -266,7 +266,7 @@ class SweepSurrogate:
                 if gp is None:
                     continue
                 mean, std, std_tissue, std_surrogate = split_predict(gp, domain, Xm, tissue)
-                unknown = error_unknown(self.cv_[seg][t])
+                unknown = error_unknown(self.cv_[seg][t], gp)
                 if unknown:  # no number where the model cannot vouch for it
                     std = std_tissue = std_surrogate = np.full(len(mean), np.nan)
                     out.loc[rows.index, "error_note"] += f"{t}: {unknown}. "
@@ -294,7 +294,7 @@ class SweepSurrogate:
                 if scatter:
                     lines.append(f"  {'':<22} noise floor {scatter['sd']:.2g} (scatter of {scatter['pairs']} replicate "
                                  f"pairs; their offset {scatter['offset']:+.2g})")
-                unknown = error_unknown(cv)
+                unknown = error_unknown(cv, gp)
                 if unknown:
                     lines.append(f"  {'':<22} {unknown}: its sd, intervals and probabilities are not printed")
             for target, why in self.skipped_[seg].items():

@@ -24,6 +24,7 @@ from colonsim.errors import ColonsimError
 from colonsim.surrogate.likelihood import inverse_from_cholesky
 
 Z95 = 1.959963984540054
+NOISE_AT_BOUND = 1.01  # a noise variance within 1 % of its lower bound sits at it
 MIN_CHECKED_RUNS = 10  # fewer: the model cannot vouch for its error (measured, docs/surrogate.md "Too few runs")
 
 
@@ -38,19 +39,29 @@ def metrics(y, mean, std):
             "z_rms": float(np.sqrt(np.mean((err / np.asarray(std)) ** 2)))}
 
 
-def error_unknown(cv: dict) -> str | None:
-    """Why the model cannot state its error (too few runs to check it, or cross-validated errors
-    larger than the sd it states), or None when it can.
+def error_unknown(cv: dict, gp) -> str | None:
+    """Why the model cannot state its error, or None when it can (docs/surrogate.md, "Too few runs").
 
-    Its intervals are vouched for when at least :data:`MIN_CHECKED_RUNS` runs were each predicted
-    without themselves and their standardized errors are consistent with the stated sd: the sum
-    of their squares below the 95th percentile of a chi-square with as many degrees of freedom (a
-    model whose sd is right exceeds it one time in twenty). docs/surrogate.md, "Too few runs"."""
+    ``cv``: its cross-validation metrics; ``gp``: the fitted :class:`GaussianProcess`. The error is
+    unknown when
+
+    - fewer than :data:`MIN_CHECKED_RUNS` runs were predicted without themselves;
+    - the noise sits at the bottom of its range and no replicate runs measured it: the fit
+      explained the runs' scatter by short length scales instead of estimating it, and its
+      intervals are then far too narrow (docs/surrogate.md, "Noise floor"), which leave-one-out with
+      those hyperparameters does not reveal;
+    - the standardized cross-validated errors are larger than the stated sd allows: the sum of
+      their squares above the 95th percentile of a chi-square with as many degrees of freedom (a
+      model whose sd is right exceeds it one time in twenty).
+    """
     n, z_rms = int(cv["n"]), cv.get("z_rms")
     if z_rms is None:
         return "its error was not cross-checked (a model of an older colonsim); refit it"
     if n < MIN_CHECKED_RUNS:
         return f"too few runs to know its error ({n} < {MIN_CHECKED_RUNS})"
+    if gp.noise_floor_sd <= 0 and gp.noise_level_ <= NOISE_AT_BOUND * gp.noise_bounds[0]:
+        return ("too few runs to know its error: the fit put the run-to-run scatter at the bottom of its range instead "
+                "of estimating it; measure it with replicate runs (fit --replicates)")
     limit = float(np.sqrt(chi2.ppf(0.95, n) / n))
     if z_rms > limit:
         return (f"too few runs to know its error: its cross-validated errors are {z_rms:.1f} times the sd it states "

@@ -106,3 +106,51 @@ def test_validate_refuses_a_table_without_the_model_inputs(floored, test_table, 
     assert main(["surrogate", "validate", str(tmp_path / "model.json"), str(tmp_path / "test.parquet")]) == 2
     err = capsys.readouterr().err.strip()
     assert err.startswith("colonsim: error:") and message in err and len(err.splitlines()) == 1
+
+
+# -- too few runs to know its error -----------------------------------------------------------------
+def test_error_is_known_with_enough_runs_and_an_estimated_noise(train):
+    from colonsim.surrogate.recommend import format_recommendation, recommend
+
+    model = SweepSurrogate(targets=(TARGET,), n_restarts=1).fit(train)
+    assert model.error_unknown("rsj", TARGET) is None
+    rec = recommend(model, "rsj", {"diameter_mm": 30.0, "friction": 0.05})
+    assert rec["p_ranking"] is not None and all(s["low95"] is not None for s in rec["scopes"])
+    assert "probability this order holds" in format_recommendation(rec)
+
+
+def test_too_few_runs_says_so_instead_of_a_number(train, tmp_path, capsys):
+    from colonsim.surrogate.recommend import format_recommendation, recommend
+    from colonsim.surrogate.store import save_surrogate
+
+    model = SweepSurrogate(targets=(TARGET,), n_restarts=1).fit(train.iloc[:6])
+    assert "too few runs to know its error (6 < 10)" == model.error_unknown("rsj", TARGET)
+    rec = recommend(model, "rsj", {"diameter_mm": 30.0, "friction": 0.05})
+    assert rec["p_ranking"] is None and all(s["std"] is None and s["p_best"] is None for s in rec["scopes"])
+    text = format_recommendation(rec)
+    assert "no probability or interval: the model rests on 6 runs" in text and "%" not in text
+    save_surrogate(model, tmp_path / "model")
+    assert main(["predict", str(tmp_path / "model.json"), "--diameter", "30", "--friction", "0.05", "--scope",
+                 "pdc"]) == 0
+    out = capsys.readouterr().out
+    assert "(no interval: too few runs to know its error (6 < 10))" in out and "+-" not in out.split("\n")[1]
+
+
+def test_noise_at_its_bound_is_not_an_estimate_unless_replicates_measured_it():
+    """Runs without scatter: the fit puts the noise at the bottom of its range, which says nothing
+    about a simulation's scatter; replicate runs that measure it make the error known."""
+    clean = rsj(24, seed=11, noise=0.0)
+    model = SweepSurrogate(targets=(TARGET,), n_restarts=1).fit(clean)
+    assert "bottom of its range" in model.error_unknown("rsj", TARGET)
+    measured = SweepSurrogate(targets=(TARGET,), n_restarts=1,
+                              replicates=replicates_of(clean, 8, seed=3, noise=0.01)).fit(clean)
+    assert measured.error_unknown("rsj", TARGET) is None
+
+
+def test_cross_validated_errors_larger_than_the_sd_make_the_error_unknown(floored):
+    from colonsim.surrogate.validation import error_unknown
+
+    gp = floored.models_["rsj"][TARGET]
+    cv = dict(floored.cv_["rsj"][TARGET])
+    assert error_unknown(cv, gp) is None and cv["z_rms"] < 1.3
+    assert "1.6 times the sd it states (at most 1.23 with 24 runs)" in error_unknown({**cv, "z_rms": 1.6}, gp)
