@@ -68,7 +68,7 @@ def print_score(label, s):
     ok = verdicts(s)
     flag = lambda key: "" if ok[key] else "!"  # noqa: E731
     o = s["orders"]
-    print(f"  {label:<24} RMSE {s['rmse']:.3g}  Q2 {s['q2']:.3f}  cover 50/90/95 {100 * s['coverage']['50']:3.0f}{flag('c50')}"
+    print(f"    {label}RMSE {s['rmse']:.3g}  Q2 {s['q2']:.3f}  cover 50/90/95 {100 * s['coverage']['50']:3.0f}{flag('c50')}"
           f"/{100 * s['coverage']['90']:3.0f}/{100 * s['coverage']['95']:3.0f}{flag('c95')} %  "
           f"z {s['z_mean']:+.2f}{flag('z_mean')} sd {s['z_sd']:.2f}{flag('z_sd')}  "
           f"orders {100 * o['held']:.0f} % vs stated {100 * o['mean_stated']:.0f} %{flag('orders')}  "
@@ -80,9 +80,13 @@ def heldout(train_folders, test_folder, replicates_folder, sizes, restarts=2, fi
     train = pd.concat([table_of(f) for f in train_folders], ignore_index=True)
     test = table_of(test_folder)
     replicates = None if replicates_folder is None else table_of(replicates_folder)
+    if replicates is not None:  # with the training runs they repeat: a subset that lacks them still has the pairs
+        inputs = ["scope_diameter_mm", "diameter_mm", "friction"]
+        originals = train.merge(replicates[inputs].drop_duplicates(), on=inputs)
+        replicates = pd.concat([replicates, originals], ignore_index=True)
     print(f"\nheld-out calibration: training runs from {', '.join(map(str, train_folders))} ({len(train)}), "
           f"held out {test_folder} ({len(test)}), replicates {replicates_folder} "
-          f"({0 if replicates is None else len(replicates)}); '!' = outside the acceptance band")
+          f"({0 if replicates is None else len(replicates)} runs with the originals); '!' = outside the acceptance band")
     kept, models = [], {}
     for size in sizes:
         runs = training_set(train, size)
@@ -100,7 +104,8 @@ def heldout(train_folders, test_folder, replicates_folder, sizes, restarts=2, fi
                 s = score(model, test, target, "rsj")
                 scatter = model.scatter_["rsj"][target]
                 floor = "" if scatter is None else f", floor {scatter['sd']:.3g} from {scatter['pairs']} pairs"
-                print(f"  {target}, {size} runs, {label}{floor}: noise sd {model.models_['rsj'][target].noise_std:.3g}")
+                print(f"  {target}, {size} runs, {label}{floor}: noise sd {model.models_['rsj'][target].noise_std:.3g}; "
+                      f"{model.error_unknown('rsj', target) or 'error known'}")
                 print_score("", s)
                 if label == ("replicate floor" if replicates is not None else "no floor"):
                     kept.append({**s, "label": f"{target}, {size} runs"})

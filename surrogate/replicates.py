@@ -20,7 +20,7 @@ import numpy as np
 import pandas as pd
 
 from colonsim.errors import ColonsimError
-from colonsim.surrogate.table import numeric_column, successful_runs
+from colonsim.surrogate.table import NOT_SETTINGS, numeric_column, successful_runs
 
 MIN_PAIRS = 3  # fewer pairs say nothing about a standard deviation
 DECIMALS = 6  # inputs equal to this many decimals are the same case
@@ -31,11 +31,15 @@ def _keys(runs: pd.DataFrame, inputs) -> list:
 
 
 def replicate_scatter(runs: pd.DataFrame, replicates: pd.DataFrame, segment, inputs, target) -> dict | None:
-    """Scatter of ``target`` from the replicate runs of ``segment`` paired with the training ``runs``
-    by their ``inputs`` (the model's varying and fixed inputs); None if the segment has none.
+    """Scatter of ``target`` from the pairs of ``segment`` runs with the same ``inputs`` (the model's
+    varying and fixed inputs) at two solver settings; None if the replicate table has no run of it.
 
-    Returns {"sd", "pairs", "offset", "unpaired"} in the target's unit; an error for fewer than
-    :data:`MIN_PAIRS` pairs (too few to measure a standard deviation)."""
+    A pair is two runs of one case among the replicate table and the training ``runs`` together
+    (a run in both, by its ``key``, counts once): a replicate with its training run, or both runs
+    of a case in the replicate table (so a model fitted on a subset of the training sweep still
+    finds the pairs). Within a pair the runs are ordered by their solver settings, so ``offset`` is
+    the mean change from one setting to the other. Returns {"sd", "pairs", "offset", "unpaired"} in
+    the target's unit; an error for fewer than :data:`MIN_PAIRS` pairs."""
     reps = successful_runs(replicates, segment)
     if reps.empty:
         return None
@@ -43,13 +47,26 @@ def replicate_scatter(runs: pd.DataFrame, replicates: pd.DataFrame, segment, inp
     if missing:
         raise ColonsimError(f"the replicate table lacks the input column(s) {', '.join(missing)} of the {segment} runs; "
                             "give the results table of the same cases run again")
-    y_train = dict(zip(_keys(runs, inputs), numeric_column(runs, target).to_numpy(dtype=float)))
-    y_rep = numeric_column(reps, target).to_numpy(dtype=float)
-    d = np.array([y - y_train[k] for k, y in zip(_keys(reps, inputs), y_rep) if k in y_train])
-    d = d[np.isfinite(d)]
+    pool = pd.concat([reps, runs], ignore_index=True)
+    if "key" in pool.columns:
+        pool = pool.drop_duplicates(subset="key")
+    y = numeric_column(pool, target).to_numpy(dtype=float)
+    settings = [c for c in pool.columns if c not in NOT_SETTINGS and c not in inputs]
+    signature = pool[settings].astype(str).agg("|".join, axis=1).to_numpy() if settings else np.full(len(pool), "")
+    groups = {}
+    for i, key in enumerate(_keys(pool, inputs)):
+        if np.isfinite(y[i]):
+            groups.setdefault(key, []).append(i)
+    d, paired = [], set()
+    for key, members in groups.items():
+        members = sorted(members, key=lambda i: signature[i])
+        if len(members) >= 2 and signature[members[0]] != signature[members[-1]]:
+            d.append(y[members[-1]] - y[members[0]])
+            paired.add(key)
     if len(d) < MIN_PAIRS:
-        raise ColonsimError(f"{segment} {target}: {len(d)} replicate run(s) pair with a training run (same inputs), "
-                            f"at least {MIN_PAIRS} are needed to measure the scatter; run training cases again at "
-                            "another mesh or push speed")
+        raise ColonsimError(f"{segment} {target}: {len(d)} pair(s) of runs of one case at two solver settings, at least "
+                            f"{MIN_PAIRS} are needed to measure the scatter; run training cases again at another mesh "
+                            "or push speed")
+    d = np.asarray(d)
     return {"sd": float(np.std(d, ddof=1) / np.sqrt(2.0)), "pairs": int(len(d)), "offset": float(np.mean(d)),
-            "unpaired": int(len(reps) - len(d))}
+            "unpaired": int(sum(key not in paired for key in _keys(reps, inputs)))}

@@ -33,6 +33,7 @@ def replicates_of(table, n, seed, noise=NOISE):
                               again["friction"])[TARGET]
     again[TARGET] = clean + 0.02 + np.random.default_rng(seed).normal(0.0, noise, n)
     again["element_size_mm"] = 2.8
+    again["key"] = again["key"] + "-fine"  # another run: another key
     return again
 
 
@@ -62,7 +63,7 @@ def test_replicate_pairs_measure_the_scatter(train, floored):
 def test_too_few_replicate_pairs_is_an_error(train):
     reps = replicates_of(train, 2, seed=13)
     runs = successful_runs(train, "rsj")
-    with pytest.raises(ColonsimError, match="2 replicate run.*at least 3"):
+    with pytest.raises(ColonsimError, match=r"2 pair\(s\) of runs of one case at two solver settings, at least 3"):
         replicate_scatter(runs, reps, "rsj", ["scope_diameter_mm", "diameter_mm", "friction"], TARGET)
 
 
