@@ -8,9 +8,9 @@ of held-out run pairs whose predicted order holds against the mean probability s
 against the acceptance band (95 %: 88-99 %, 50 %: 38-62 %, |mean z| <= 0.3, sd z 0.7-1.4, orders
 hold >= stated - 5 points); and the query speed of the fitted model.
 
-Training sets: the rows of the ``--train`` folders in order; a size smaller than all of them is
-the maximin subset of that size (the most spread-out runs, chosen greedily from the centre), a
-size equal to their total is all of them. Used by ``benchmarks/bench_surrogate.py --heldout``.
+Training sets: up to the runs of the first ``--heldout`` folder, that sweep or its maximin subset
+(the most spread-out runs, chosen greedily from the centre); above, all the folders together or
+their maximin subset. Used by ``benchmarks/bench_surrogate.py --heldout``.
 """
 
 from __future__ import annotations
@@ -48,12 +48,16 @@ def maximin_subset(X, k):
     return np.sort(chosen)
 
 
-def training_set(train: pd.DataFrame, size, inputs=("scope_diameter_mm", "diameter_mm", "friction")):
-    if size > len(train):
+def training_set(folders, size, inputs=("scope_diameter_mm", "diameter_mm", "friction")):
+    """The first training sweep (or its maximin subset) for sizes up to its runs, else all the
+    sweeps together (or their maximin subset): 12 and 20 come from gp_train.toml, 40 is both."""
+    first = folders[0]
+    pool = first if size <= len(first) else pd.concat(folders, ignore_index=True)
+    if size > len(pool):
         return None
-    if size == len(train):
-        return train
-    return train.iloc[maximin_subset(train[list(inputs)].to_numpy(dtype=float), size)]
+    if size == len(pool):
+        return pool
+    return pool.iloc[maximin_subset(pool[list(inputs)].to_numpy(dtype=float), size)]
 
 
 def verdicts(s) -> dict:
@@ -77,7 +81,8 @@ def print_score(label, s):
 
 def heldout(train_folders, test_folder, replicates_folder, sizes, restarts=2, figure=None, targets=TARGETS):
     """Print the held-out scores; returns the scores of the model with the floor (for the figure)."""
-    train = pd.concat([table_of(f) for f in train_folders], ignore_index=True)
+    folders = [table_of(f) for f in train_folders]
+    train = pd.concat(folders, ignore_index=True)
     test = table_of(test_folder)
     replicates = None if replicates_folder is None else table_of(replicates_folder)
     if replicates is not None:  # with the training runs they repeat: a subset that lacks them still has the pairs
@@ -89,7 +94,7 @@ def heldout(train_folders, test_folder, replicates_folder, sizes, restarts=2, fi
           f"({0 if replicates is None else len(replicates)} runs with the originals); '!' = outside the acceptance band")
     kept, models = [], {}
     for size in sizes:
-        runs = training_set(train, size)
+        runs = training_set(folders, size)
         if runs is None:
             print(f"  {size} runs: only {len(train)} training runs, skipped")
             continue

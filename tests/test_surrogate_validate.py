@@ -155,3 +155,14 @@ def test_cross_validated_errors_larger_than_the_sd_make_the_error_unknown(floore
     cv = dict(floored.cv_["rsj"][TARGET])
     assert error_unknown(cv, gp) is None and cv["z_rms"] < 1.3
     assert "1.6 times the sd it states (at most 1.23 with 24 runs)" in error_unknown({**cv, "z_rms": 1.6}, gp)
+
+
+def test_fit_with_replicates_on_the_command_line(train, tmp_path, capsys):
+    train.to_parquet(tmp_path / "train.parquet")
+    replicates_of(train, 5, seed=13).to_parquet(tmp_path / "again.parquet")
+    assert main(["surrogate", "fit", str(tmp_path / "train.parquet"), "-o", str(tmp_path / "model"), "--restarts", "0",
+                 "--targets", TARGET, "--replicates", str(tmp_path / "again.parquet")]) == 0
+    assert "noise floor" in capsys.readouterr().out and "(scatter of 5 replicate pairs" in (
+        main(["surrogate", "info", str(tmp_path / "model.json")]) or capsys.readouterr().out)
+    doc = json.loads((tmp_path / "model.json").read_text())
+    assert doc["segments"]["rsj"]["models"][TARGET]["scatter"]["pairs"] == 5
