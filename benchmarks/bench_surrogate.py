@@ -22,8 +22,16 @@ Part 2 (the issue's targets for the whole surrogate, ``--model-runs`` runs): the
 default output with LOO CV (target < 30 s), save and load, one query with the domain check
 (target < 1 ms), 10,000 queries (target < 1 s).
 
+Part 3 (with ``--heldout``, :mod:`bench_heldout`): the surrogate fitted on training sweeps of
+``--train-sizes`` runs, without and with the noise floor of ``--replicates``, scored on the
+independent sweep ``--test``: interval coverage, standardized error and predicted orders against
+the acceptance bands, a reliability plot (``--figure``), and the query speed of the largest model
+(targets < 0.5 ms for one query, < 0.5 s for 10,000).
+
 Run: ``NUMBA_NUM_THREADS=1 python benchmarks/bench_surrogate.py [--sizes 40 150 500]
-[--results /work/sweeps/thesis2] [--restarts 2] [--target final_deformation_cm] [--model-runs 500]``.
+[--results /work/sweeps/thesis2] [--restarts 2] [--target final_deformation_cm] [--model-runs 500]
+[--heldout TRAIN [TRAIN ...] --test TEST --replicates REPLICATES --train-sizes 12 20 40 --figure F.png]``
+(docs/surrogate.md, "Noise floor", gives the sweeps and the command).
 BLAS runs on one thread for both fits (as the surrogate's own fit). Needs scikit-learn, which is
 in the test extra (``pip install "colonsim[test]"``). On a shared machine timings vary by +-20 %.
 """
@@ -46,6 +54,7 @@ from colonsim.surrogate.store import load_surrogate, save_surrogate
 from colonsim.surrogate.synthetic import synthetic_outputs, synthetic_sweep
 from colonsim.surrogate.table import numeric_column, read_results, split_inputs, successful_runs
 from colonsim.surrogate.validation import loo_predictions, metrics
+from bench_heldout import heldout, query_speed
 
 try:
     from sklearn.gaussian_process import GaussianProcessRegressor
@@ -219,7 +228,17 @@ def main():
     parser.add_argument("--restarts", type=int, default=2, help="optimizer restarts per GP (the CLI default, 2)")
     parser.add_argument("--queries", type=int, default=10_000)
     parser.add_argument("--model-runs", type=int, default=500, help="runs of part 2's table; 0 skips part 2")
+    parser.add_argument("--heldout", type=Path, nargs="+", help="part 3: training sweep folders (RSJ, in order)")
+    parser.add_argument("--test", type=Path, help="part 3: the held-out sweep folder")
+    parser.add_argument("--replicates", type=Path, help="part 3: training cases run again (the noise floor)")
+    parser.add_argument("--train-sizes", type=int, nargs="+", default=[12, 20, 40], help="part 3: training runs")
+    parser.add_argument("--figure", type=Path, help="part 3: reliability plot of the model with the floor")
     args = parser.parse_args()
+    if args.heldout:
+        if args.test is None:
+            parser.error("--heldout needs --test")
+        models = heldout(args.heldout, args.test, args.replicates, args.train_sizes, args.restarts, args.figure)
+        query_speed(models[max(models, key=lambda key: key[0])])
 
     # an optimum at a bound is normal here (a length scale of 100 = the output ignores that input)
     warnings.simplefilter("ignore", ConvergenceWarning)

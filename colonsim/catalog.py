@@ -410,6 +410,13 @@ def columns(kind=None, surrogate=None) -> tuple:
                  if (kind is None or c.kind == kind) and (surrogate is None or c.surrogate in surrogate))
 
 
+# The pain proxy: the output the surrogate ranks scopes by, and predicts, plots and summarizes by
+# default. The largest deformation over the run, not the final one: the source reports deformation
+# at the end of its runs, which in its models is the largest; here the final value is read after
+# the sigmoid has relaxed in the fixed exit (docs/surrogate.md, "The pain proxy").
+PAIN_PROXY = "max_deformation_cm"
+
+
 def column_unit(name) -> str:
     """Unit of a results-table column ("" for none, and for columns the catalog does not hold)."""
     column = COLUMNS.get(name)

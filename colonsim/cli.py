@@ -89,7 +89,7 @@ def cmd_demo(args):
     from colonsim.demo import DemoOptions, run_demo
 
     run_demo(DemoOptions(out=args.out, element_size_mm=args.element_size, workers=args.workers,
-                         show_progress=not args.no_progress))
+                         show_progress=not args.no_progress, target=args.target))
 
 
 def _add_insert(sub):
@@ -189,6 +189,8 @@ def build_parser():
     demo.add_argument("--workers", type=positive_int, default=None,
                       help="processes for the demo's sweep (default: up to 2 cores)")
     demo.add_argument("--no-progress", action="store_true", help="no progress bar")
+    demo.add_argument("--target", choices=("max_deformation_cm", "final_deformation_cm"), default=catalog.PAIN_PROXY,
+                      help="deformation the summary and the recommendations rank by (default: the largest over the run)")
     demo.set_defaults(func=cmd_demo)
     return parser
 

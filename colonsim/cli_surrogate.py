@@ -1,4 +1,4 @@
-"""Command line of the surrogate: ``colonsim surrogate fit|plot|info``, ``colonsim predict``,
+"""Command line of the surrogate: ``colonsim surrogate fit|plot|info|validate``, ``colonsim predict``,
 ``colonsim recommend`` (docs/surrogate.md).
 
 Patient presets (--sex, --age, --region) and raw parameters (--angle, --friction, --diameter, ...)
@@ -78,6 +78,9 @@ def add_parsers(sub):
     fit.add_argument("--seed", type=int, default=0, help="seed of the restarts and folds (default 0)")
     fit.add_argument("--material", type=Path, help=MATERIAL_HELP.replace("predictions average", "stored with the "
                                                                           "model, that predictions average"))
+    fit.add_argument("--replicates", type=Path,
+                     help="results table of training cases run again at another mesh or push speed: their scatter "
+                          "is each output's noise floor (docs/surrogate.md, 'Noise floor')")
     fit.add_argument("--threads", type=int, default=1,
                      help="BLAS threads (default 1; more only pays on an idle machine with thousands of runs)")
     fit.set_defaults(func=cmd_fit)
@@ -87,12 +90,26 @@ def add_parsers(sub):
     info.add_argument("--json", action="store_true", help="print the model's JSON document")
     info.set_defaults(func=cmd_info)
 
+    val = ssub.add_parser("validate", help="score a model on runs it was not fitted on",
+                          description="RMSE, Q2, coverage of the 50/90/95 %% intervals, mean and sd of the "
+                                      "standardized error, and how often predicted orders of run pairs hold against "
+                                      "the probability stated, on a held-out results table (docs/surrogate.md).")
+    val.add_argument("model", type=Path, help="MODEL.json written by 'colonsim surrogate fit'")
+    val.add_argument("table", type=Path, help="results.parquet (or .csv) of runs the model was not fitted on")
+    val.add_argument("--target", nargs="+", help="outputs to score (default: those the model has and the table holds)")
+    val.add_argument("--segment", help="segment to score (default: the model's only one)")
+    val.add_argument("--plot", type=output_file(".png", ".pdf", ".svg"), help="reliability plot: nominal against "
+                                                                                  "observed coverage")
+    val.add_argument("--json", action="store_true", help="JSON output")
+    val.add_argument("-o", "--out", type=output_file(".json"), help="write the scores to this JSON file")
+    val.set_defaults(func=cmd_validate)
+
     plot = ssub.add_parser("plot", help="predicted output against one input, with its 95 %% band",
                            description="One curve per scope over the input's training range; the other inputs "
                                        "from the patient options.")
     plot.add_argument("model", type=Path)
     plot.add_argument("--vs", required=True, help="scope, diameter, angle, friction or wall-thickness")
-    plot.add_argument("--target", default="final_deformation_cm", help="output column (default final_deformation_cm)")
+    plot.add_argument("--target", default=catalog.PAIN_PROXY, help=f"output column (default {catalog.PAIN_PROXY}, the pain proxy)")
     _patient_options(plot)
     plot.add_argument("-o", "--out", type=output_file(".png", ".pdf", ".svg"), required=True,
                       help="figure file (.png, .pdf, .svg)")
@@ -116,7 +133,8 @@ def add_parsers(sub):
                                      "ranking from the joint GP posterior (docs/surrogate.md).")
     rec.add_argument("model", type=Path)
     _patient_options(rec, scope_diameter=False)
-    rec.add_argument("--target", default="final_deformation_cm", help="output to rank by (default final_deformation_cm)")
+    rec.add_argument("--target", default=catalog.PAIN_PROXY, help=f"output to rank by (default {catalog.PAIN_PROXY}, the largest "
+                     "deformation over the run: docs/surrogate.md, 'The pain proxy'; final_deformation_cm is the end value)")
     rec.add_argument("--reference", help="scope the others are compared with (default sdc)")
     rec.add_argument("--json", action="store_true", help="JSON output")
     rec.add_argument("-o", "--out", type=output_file(".json"), help="write the JSON recommendation to this file")
@@ -142,9 +160,10 @@ def cmd_fit(args):
         raise ColonsimError("--restarts must be >= 0, --min-runs >= 2 and --threads >= 1")
     tissue = _tissue(args)
     table = read_results(args.results)
+    replicates = None if args.replicates is None else read_results(args.replicates)
     model = SweepSurrogate(targets=tuple(args.targets or TARGETS), segments=args.segments, cv=args.cv,
                            n_restarts=args.restarts, min_runs=args.min_runs, random_state=args.seed,
-                           threads=args.threads, tissue=tissue).fit(table)
+                           threads=args.threads, tissue=tissue, replicates=replicates).fit(table)
     json_path, npz_path = save_surrogate(model, args.out, source=args.results)
     print(model.report())
     print(f"model: {json_path} + {npz_path.name}")
@@ -158,6 +177,32 @@ def cmd_info(args):
         print(model_paths(args.model)[0].read_text(encoding="utf-8"), end="")
     else:
         print(model.report())
+
+
+def cmd_validate(args):
+    from colonsim.files import save_figure, write_json
+    from colonsim.surrogate.holdout import format_score, reliability_figure, score
+    from colonsim.surrogate.store import load_surrogate
+    from colonsim.surrogate.table import read_results, target_unit
+
+    model = load_surrogate(args.model)
+    table = read_results(args.table)
+    segment = _segment(args, model)
+    fitted = list(model.models_.get(segment, {}))
+    targets = args.target or [t for t in fitted if t in table.columns]
+    if not targets:
+        raise ColonsimError(f"{args.table} holds none of the outputs the model has ({', '.join(fitted) or 'none'})")
+    scores = [score(model, table, t, segment, name=str(args.table)) for t in targets]
+    if args.out:
+        write_json(args.out, {"model": str(args.model), "table": str(args.table), "scores": scores})
+    if args.plot:
+        save_figure(reliability_figure(scores), args.plot)
+    if args.json:
+        print(json.dumps({"scores": scores}, indent=2, allow_nan=False))
+    else:
+        print("\n".join(format_score(s, target_unit(s["target"])) for s in scores))
+        for path in (p for p in (args.out, args.plot) if p):
+            print(f"written: {path}")
 
 
 def _tissue(args):
@@ -255,6 +300,11 @@ def _records(frame):
             for row in frame.to_dict(orient="records")]
 
 
+def _error_of(note, target):
+    """The reason ``error_note`` gives for ``target``."""
+    return next((part.split(": ", 1)[1] for part in note.split(". ") if part.startswith(target + ": ")), "")
+
+
 def _format_predictions(out, targets):
     from colonsim.surrogate.table import INPUTS, target_unit
 
@@ -268,6 +318,9 @@ def _format_predictions(out, targets):
                 unit = target_unit(t)
                 split = ("" if row[t + "_std_tissue"] != row[t + "_std_tissue"] else
                          f"  sd: tissue {row[t + '_std_tissue']:.2g}, surrogate {row[t + '_std_surrogate']:.2g}")
+                if row[t + "_std"] != row[t + "_std"]:  # the model cannot vouch for a spread: no number
+                    lines.append(f"  {t:<22} {row[t]:8.4g} {unit}  (no interval: {_error_of(row['error_note'], t)})")
+                    continue
                 lines.append(f"  {t:<22} {row[t]:8.4g} +- {row[t + '_std']:.2g} {unit}  "
                              f"(95 %: {row[t + '_low95']:.4g} to {row[t + '_high95']:.4g}){split}")
         lines.append(f"  {row['tissue_note']}")

@@ -2,9 +2,12 @@
 
 1. calibrate Mooney-Rivlin parameters from the bundled SYNTHETIC tensile curves (reduced budget);
 2. RSJ insertions of UTC, PDC and SDC (D = 36 mm, mu = 0) with the material just calibrated;
-3. a small sweep: RSJ x 3 scopes x D 23/36 mm x mu 0/0.1 (12 runs on local processes);
-4. a surrogate fitted on that sweep (leave-one-out cross-validation reported);
-5. a scope recommendation for two contrasting patients.
+3. a small sweep: RSJ x 3 scopes x D 23/36 mm x mu 0/0.1 (12 runs on local processes), and 4 of
+   its cases again on a finer mesh (the simulation's scatter);
+4. a surrogate fitted on that sweep, its noise floored at that scatter (leave-one-out
+   cross-validation reported);
+5. a scope recommendation for two contrasting patients, by the largest colon deformation over the
+   run (the pain proxy, docs/surrogate.md; ``--target final_deformation_cm`` for the end value).
 
 Everything goes to one folder (default ``colonsim_demo/``); ``report.md`` there lists what was
 run and where each file is. Rerunning into the same folder skips the sweep runs already done.
@@ -16,6 +19,7 @@ import time
 from dataclasses import dataclass
 from pathlib import Path
 
+from colonsim.catalog import PAIN_PROXY
 from colonsim.workflows import available_cores
 
 DEMO_SWEEP = """
@@ -34,12 +38,32 @@ diameter_mm = [23, 36]
 friction = [0, 0.1]
 """
 
+# Four of its cases again on a 7 % finer wall mesh: the pairs measure the simulation's own
+# scatter, the surrogate's noise floor (docs/surrogate.md, "Noise floor").
+DEMO_REPLICATES = """
+[sweep]
+name = "demo_replicates"
+description = "4 cases of the demo sweep on a 7 % finer wall mesh (the simulation's scatter)"
+
+[fixed]
+material = "{material}"
+element_size_mm = {element_size}
+friction = 0.1
+
+[[grid]]
+segment = "rsj"
+scope = ["utc", "sdc"]
+diameter_mm = [23, 36]
+"""
+REPLICATE_MESH = 0.93  # the replicates' wall mesh over the sweep's
+
 # Two patients at opposite corners of the sweep (presets of surrogate/patients.py).
 PATIENTS = (
     {"label": "young African patient", "age": "young", "region": "african"},
     {"label": "older European patient (diverticular disease)", "age": "older", "region": "european"},
 )
-SURROGATE_TARGETS = ("final_deformation_cm", "point_A_cm", "peak_contact_force_N", "max_wall_stretch")
+SURROGATE_TARGETS = ("max_deformation_cm", "final_deformation_cm", "point_A_cm", "peak_contact_force_N",
+                     "max_wall_stretch")
 
 
 def _section(text):
@@ -83,14 +107,21 @@ def sweep_step(material: Path, element_size: float, out: Path, workers: int, sho
     rate = f" ({report.runs_per_hour:.0f} runs/hour)" if report.ran else ""
     print(f"{report.skipped} already done, {report.ran} run in {report.wall_time_s:.0f} s{rate}: {report.ok} ok, "
           f"{report.failed} failed -> {out / 'results.parquet'}")
-    cols = ["scope", "diameter_mm", "friction", "status", "point_A_cm", "point_C_cm", "final_deformation_cm",
-            "peak_contact_force_N", "wall_time_s"]
+    cols = ["scope", "diameter_mm", "friction", "status", "point_A_cm", "point_C_cm", "max_deformation_cm",
+            "final_deformation_cm", "peak_contact_force_N", "wall_time_s"]
     table = report.table.sort_values(["diameter_mm", "friction", "scope_diameter_mm"])[cols]
     print(table.to_string(index=False, float_format=lambda v: f"{v:.3g}"))
+    text = DEMO_REPLICATES.format(material=material.resolve().as_posix(),
+                                  element_size=round(REPLICATE_MESH * element_size, 3))
+    spec = parse_sweep(text, origin="demo replicates")
+    print(f"replicates: {spec.description}")
+    again = run_sweep(spec.cases, out.with_name("replicates"), workers=workers, spec=spec, progress=show)
+    print(f"{again.skipped} already done, {again.ran} run: {again.ok} ok, {again.failed} failed -> "
+          f"{out.with_name('replicates') / 'results.parquet'}")
     return report
 
 
-def surrogate_step(results: Path, out: Path):
+def surrogate_step(results: Path, replicates: Path, out: Path):
     from colonsim.files import save_figure
     from colonsim.surrogate.model import SweepSurrogate
     from colonsim.surrogate.plot import prediction_figure
@@ -98,7 +129,8 @@ def surrogate_step(results: Path, out: Path):
     from colonsim.surrogate.table import read_results
 
     _section("4/5 Gaussian-process surrogate of the sweep (leave-one-out cross-validation)")
-    model = SweepSurrogate(targets=SURROGATE_TARGETS, random_state=0).fit(read_results(results))
+    model = SweepSurrogate(targets=SURROGATE_TARGETS, random_state=0,
+                           replicates=read_results(replicates)).fit(read_results(results))
     json_path, _ = save_surrogate(model, out / "surrogate", source=results)
     print(model.report())
     figures = []
@@ -110,7 +142,7 @@ def surrogate_step(results: Path, out: Path):
     return model, json_path, figures
 
 
-def recommend_step(model, out: Path):
+def recommend_step(model, out: Path, target):
     from colonsim.files import write_json
     from colonsim.surrogate.patients import describe_patient, patient_inputs
     from colonsim.surrogate.recommend import format_recommendation, recommend
@@ -119,7 +151,7 @@ def recommend_step(model, out: Path):
     recs = []
     for p in PATIENTS:
         inputs = patient_inputs("rsj", age=p["age"], region=p["region"])
-        rec = recommend(model, "rsj", inputs)
+        rec = recommend(model, "rsj", inputs, target=target)
         rec["patient"] = {"label": p["label"], "age": p["age"], "region": p["region"],
                           "mapping": describe_patient("rsj", age=p["age"], region=p["region"])}
         recs.append(rec)
@@ -155,52 +187,60 @@ def write_report(out: Path, calibration, insertions, sweep, model, recs, seconds
               "![RSJ insertions](insertion/comparison.png)", "",
               "## 3. Sweep (`sweep/`)", "",
               f"{sweep.total} runs, {int((sweep.table['status'] == 'ok').sum())} ok. "
-              "Table: `sweep/results.parquet`; time series: `sweep/runs/<key>/`.", "",
+              "Table: `sweep/results.parquet`; time series: `sweep/runs/<key>/`; four of its cases on a finer mesh, "
+              "whose scatter is the surrogate's noise floor: `replicates/results.parquet`.", "",
               frame_table(sweep.table.sort_values(["diameter_mm", "friction", "scope_diameter_mm"])[
-                  ["scope", "diameter_mm", "friction", "point_A_cm", "point_C_cm", "final_deformation_cm",
-                   "peak_contact_force_N"]], _cell), "",
+                  ["scope", "diameter_mm", "friction", "point_A_cm", "point_C_cm", "max_deformation_cm",
+                   "final_deformation_cm", "peak_contact_force_N"]], _cell), "",
               "## 4. Surrogate (`surrogate.json` + `surrogate.npz`)", "", "```", model.report(), "```", "",
               "![surrogate vs colon diameter](surrogate_vs_diameter_mm.png)", "",
               "## 5. Recommendations (`recommendations.json`)", ""]
     for rec in recs:
         lines += [f"**{rec['patient']['label']}** ({rec['patient']['mapping']})", "", "```",
                   format_recommendation(rec), "```", ""]
-    lines += ["These numbers come from a 12-run sweep: the surrogate's cross-validation above says how far to "
+    lines += [f"These numbers come from a {sweep.total}-run sweep: the surrogate's cross-validation above says how far to "
               "trust them. `colonsim sweep --preset thesis` runs the source's 39 insertions."]
     with atomic_path(out / "report.md") as tmp:
         tmp.write_text("\n".join(lines) + "\n", encoding="utf-8")
     return out / "report.md"
 
 
-def print_summary(calibration, insertions, model, recs):
-    """The demo's findings in a few lines."""
+def print_summary(calibration, insertions, model, recs, target=PAIN_PROXY):
+    """The demo's findings in a few lines, by ``target`` (default the pain proxy)."""
     from colonsim.laws import get_law
 
     _section("summary")
     mu0 = get_law(calibration.model["law"]).initial_shear_modulus(calibration.parameters)
     print(f"calibration: small-strain shear modulus mu0 = {mu0 / 1e3:.1f} kPa "
           f"({', '.join(f'{n} {v / 1e3:.1f} kPa' for n, v in calibration.parameter_dict.items())})")
-    print("RSJ D = 36 mm, mu = 0, final colon deformation: " + ", ".join(
-        f"{r.summary['scope']['name']} {r.summary['final_deformation_cm']:.2f} cm" for r in insertions))
-    cv = model.cv_["rsj"]["final_deformation_cm"]
-    print(f"surrogate of the final deformation: leave-one-out RMSE {cv['rmse']:.2f} cm, "
-          f"95 % interval coverage {100 * cv['coverage_95']:.0f} % over {cv['n']} runs")
+    what = "largest colon deformation over the run" if target == PAIN_PROXY else target
+    print(f"RSJ D = 36 mm, mu = 0, {what}: " + ", ".join(
+        f"{r.summary['scope']['name']} {r.summary[target]:.2f} cm" for r in insertions))
+    cv = model.cv_["rsj"][target]
+    unknown = model.error_unknown("rsj", target)
+    print(f"surrogate of the {what}: rests on {cv['n']} runs; leave-one-out RMSE {cv['rmse']:.2f} cm"
+          + (f"; {unknown}, so no interval or probability below" if unknown else
+             f", 95 % interval coverage {100 * cv['coverage_95']:.0f} %"))
     for rec in recs:
-        best = rec["scopes"][0]
-        print(f"{rec['patient']['label']}: {' < '.join(s.upper() for s in rec['ranking'])} "
-              f"(P(order) {100 * rec['p_ranking']:.0f} % from the surrogate's trend, "
-              f"{100 * rec['p_ranking_with_cv_error']:.0f} % allowing its cross-validated error; "
-              f"{best['scope'].upper()} {best['mean']:.2f} cm)")
+        scopes = "  ".join(f"{s['scope'].upper()} {s['mean']:.2f} cm" + ("" if s["low95"] is None else
+                           f" [95 % {s['low95']:.2f}, {s['high95']:.2f}]") for s in rec["scopes"])
+        order = " < ".join(s.upper() for s in rec["ranking"])
+        sure = ("" if rec["p_ranking"] is None else
+                f" (probability {100 * rec['p_ranking']:.0f} %; {100 * rec['p_ranking_with_cv_error']:.0f} % "
+                "allowing the cross-validated error)")
+        print(f"{rec['patient']['label']}: {scopes}\n  {order}{sure}")
 
 
 @dataclass(frozen=True)
 class DemoOptions:
-    """Where the demo writes, its wall mesh (mm), sweep processes (None: up to 2 cores) and bars."""
+    """Where the demo writes, its wall mesh (mm), sweep processes (None: up to 2 cores), bars, and
+    the deformation the summary and the recommendations rank by."""
 
     out: Path = Path("colonsim_demo")
     element_size_mm: float = 3.0
     workers: int | None = None
     show_progress: bool = True
+    target: str = PAIN_PROXY
 
 
 def run_demo(options: DemoOptions):
@@ -220,11 +260,11 @@ def run_demo(options: DemoOptions):
     sweep = sweep_step(material, options.element_size_mm, out / "sweep", workers, show)
     seconds["sweep"] = time.perf_counter() - t
     t = time.perf_counter()
-    model, _, _ = surrogate_step(out / "sweep" / "results.parquet", out)
-    recs = recommend_step(model, out)
+    model, _, _ = surrogate_step(out / "sweep" / "results.parquet", out / "replicates" / "results.parquet", out)
+    recs = recommend_step(model, out, options.target)
     seconds["surrogate and recommendations"] = time.perf_counter() - t
     report = write_report(out, calibration, insertions, sweep, model, recs, seconds, options.element_size_mm)
-    print_summary(calibration, insertions, model, recs)
+    print_summary(calibration, insertions, model, recs, options.target)
     print(f"\ndemo finished in {time.perf_counter() - t0:.0f} s; report: {report}; every file in {out}/")
     print("Next: `colonsim sweep --preset thesis` runs the source's 39 insertions; `colonsim surrogate fit` and "
           "`colonsim recommend` work on its results.parquet the same way.")

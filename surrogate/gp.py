@@ -39,11 +39,16 @@ class GaussianProcess:
         Optimizer runs from random log-uniform starting points, besides the default start.
     random_state : int
         Seed of the restarts.
+    noise_floor_sd : float
+        Smallest standard deviation of the run-to-run scatter, target units (0: none). The
+        lower bound of the noise variance becomes at least its square (the scatter measured by
+        replicate runs, :mod:`colonsim.surrogate.replicates`).
     """
 
     def __init__(self, input_range=None, constant_bounds=(1e-2, 1e2), length_scale_bounds=(1e-2, 1e2),
-                 noise_bounds=(1e-6, 1.0), n_restarts=2, random_state=0):
+                 noise_bounds=(1e-6, 1.0), n_restarts=2, random_state=0, noise_floor_sd=0.0):
         self.input_range = input_range
+        self.noise_floor_sd = noise_floor_sd
         self.constant_bounds = constant_bounds
         self.length_scale_bounds = length_scale_bounds
         self.noise_bounds = noise_bounds
@@ -68,7 +73,10 @@ class GaussianProcess:
         return self
 
     def _bounds(self, d):
-        return np.log([self.constant_bounds] + [self.length_scale_bounds] * d + [self.noise_bounds])
+        low, high = self.noise_bounds
+        floor = (self.noise_floor_sd / self.y_scale_) ** 2  # standardized units
+        noise = (max(low, floor), max(high, floor))
+        return np.log([self.constant_bounds] + [self.length_scale_bounds] * d + [noise])
 
     def _optimize(self, Xs, ys):
         d = Xs.shape[1]

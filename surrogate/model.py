@@ -4,7 +4,8 @@
 return_std=True)`` answers in microseconds. Learned state lives in attributes ending with ``_``:
 ``domains_`` (segment -> :class:`SegmentDomain`), ``models_`` (segment -> target ->
 :class:`GaussianProcess`), ``cv_`` (segment -> target -> cross-validation metrics), ``skipped_``
-(segment -> target -> why no model), ``notes_`` (things about the table a user should know).
+(segment -> target -> why no model), ``scatter_`` (segment -> target -> the scatter measured by
+replicate runs, or None), ``notes_`` (things about the table a user should know).
 """
 
 from __future__ import annotations
@@ -14,11 +15,13 @@ import pandas as pd
 
 from colonsim.errors import ColonsimError
 from colonsim.surrogate.domain import SegmentDomain
+from colonsim.surrogate.replicates import replicate_scatter
 from colonsim.surrogate.gp import GaussianProcess
-from colonsim.surrogate.table import (INPUT_OPTIONS, INPUTS, TARGETS, check_results, numeric_column, scope_diameter_mm,
-                             scope_diameters, solver_settings, split_inputs, successful_runs)
+from colonsim.surrogate.table import (INPUT_OPTIONS, INPUTS, PAIN_PROXY, TARGETS, check_results, numeric_column,
+                                      scope_diameter_mm, scope_diameters, solver_settings, split_inputs,
+                                      successful_runs)
 from colonsim.surrogate.tissue import TISSUE_INPUTS, TissueDistribution, plan, split_predict, tissue_inputs
-from colonsim.surrogate.validation import Z95, cross_validate
+from colonsim.surrogate.validation import Z95, cross_validate, error_unknown
 from colonsim.insertion.study.material_samples import MATERIAL_PARAMETERS
 
 # columns of each target in predict_frame (the 95 % interval is mean +- 1.96 total sd)
@@ -51,10 +54,14 @@ class SweepSurrogate:
     tissue : TissueDistribution or None
         The wall-material distribution predictions average over (:mod:`colonsim.surrogate.tissue`);
         default: the one the sweep sampled, read from the runs (``tissue_``).
+    replicates : DataFrame or None
+        Results table of training cases run again at another mesh or push speed: per output, the
+        scatter of the pairs is the noise floor of its GP (:mod:`colonsim.surrogate.replicates`,
+        ``scatter_``). None: no floor.
     """
 
     def __init__(self, targets=TARGETS, inputs=INPUTS, segments=None, cv="loo", n_restarts=2, min_runs=4,
-                 random_state=0, threads=1, tissue=None):
+                 random_state=0, threads=1, tissue=None, replicates=None):
         self.targets = targets
         self.inputs = inputs
         self.segments = segments
@@ -64,10 +71,11 @@ class SweepSurrogate:
         self.random_state = random_state
         self.threads = threads
         self.tissue = tissue
+        self.replicates = replicates
 
-    def _make_gp(self, domain):
+    def _make_gp(self, domain, noise_floor_sd=0.0):
         return lambda: GaussianProcess(input_range=(domain.low, domain.high), n_restarts=self.n_restarts,
-                                       random_state=self.random_state)
+                                       random_state=self.random_state, noise_floor_sd=noise_floor_sd)
 
     def fit(self, table: pd.DataFrame):
         """Fit every (segment, target) model on the runs with status "ok"; returns self."""
@@ -79,11 +87,12 @@ class SweepSurrogate:
     def _fit(self, table):
         if self.cv != "loo" and not (isinstance(self.cv, (int, np.integer)) and self.cv >= 2):
             raise ColonsimError(f"cv must be 'loo' or a number of folds >= 2, got {self.cv!r}")
+        replicates = None if self.replicates is None else check_results(self.replicates, "replicate table")
         unknown = sorted(set(self.targets) - set(table.columns))
         if unknown:
             raise ColonsimError(f"the results table has no column {', '.join(unknown)}; choose targets among its outputs")
         segments = self.segments or [s for s in dict.fromkeys(table["segment"]) if (table["segment"] == s).any()]
-        self.domains_, self.models_, self.cv_, self.skipped_, self.notes_ = {}, {}, {}, {}, []
+        self.domains_, self.models_, self.cv_, self.skipped_, self.notes_, self.scatter_ = {}, {}, {}, {}, [], {}
         self.training_ = {"runs": int(len(table)), "ok": int((table["status"] == "ok").sum()),
                           "failed": int((table["status"] != "ok").sum())}
         absent = [name for name in self.inputs if name not in table.columns]
@@ -118,6 +127,7 @@ class SweepSurrogate:
                                    "were not quasi-static (KE/IE check without the scope's imposed sliding); "
                                    "they train like the others")
             self.models_[segment], self.cv_[segment], self.skipped_[segment] = {}, {}, {}
+            self.scatter_[segment] = {}
             for target in self.targets:
                 y = numeric_column(runs, target).to_numpy()
                 keep = np.isfinite(y)
@@ -133,14 +143,17 @@ class SweepSurrogate:
                     self.notes_.append(f"{segment} {target}: {int((~keep).sum())} of {len(y)} successful runs left "
                                        f"out ({' and '.join(why)}), {int(keep.sum())} used")
                 X = runs.loc[keep, varying].to_numpy(dtype=float)
+                scatter = None if replicates is None else replicate_scatter(runs, replicates, segment,
+                                                                            [*varying, *fixed], target)
+                self.scatter_[segment][target] = scatter
+                make_gp = self._make_gp(domain, 0.0 if scatter is None else scatter["sd"])
                 with np.errstate(over="ignore", invalid="ignore"):  # an overflow shows in the check below
-                    gp = self._make_gp(domain)().fit(X, y[keep])
+                    gp = make_gp().fit(X, y[keep])
                 if not all(np.isfinite(v).all() for v in (gp.y_scale_, gp.alpha_, gp.L_, gp.length_scale_)):
                     raise ColonsimError(f"{segment} {target}: the fit is not finite (values from {y[keep].min():.3g} "
                                         f"to {y[keep].max():.3g}); check that column's values and unit")
                 self.models_[segment][target] = gp
-                self.cv_[segment][target] = cross_validate(gp, X, y[keep], self.cv, self._make_gp(domain),
-                                                           self.random_state)
+                self.cv_[segment][target] = cross_validate(gp, X, y[keep], self.cv, make_gp, self.random_state)
         self.tissue_, note = ((self.tissue, None) if self.tissue is not None
                               else TissueDistribution.from_runs(table[table["status"] == "ok"]))
         if note and any(tissue_inputs(d) for d in self.domains_.values()):
@@ -164,6 +177,13 @@ class SweepSurrogate:
                                 f"{', '.join(self.models_[segment]) or 'none'}")
         return self.domains_[segment], model
 
+    def error_unknown(self, segment, target) -> str | None:
+        """Why the model of ``segment`` and ``target`` cannot state its error (too few runs to check
+        it), or None when its sd, intervals and probabilities are vouched for
+        (:func:`colonsim.surrogate.validation.error_unknown`)."""
+        domain, gp = self.model_for(segment, target)
+        return error_unknown(self.cv_[domain.segment][target], gp)
+
     def query(self, segment, values: dict) -> dict:
         """``values`` with scope names (key ``scope``) turned into ``scope_diameter_mm``; a diameter
         given as well wins, names fill the rows where it is missing (NaN)."""
@@ -183,7 +203,7 @@ class SweepSurrogate:
                                        np.where(np.isnan(np.asarray(given, dtype=float)), from_names, given))
         return values
 
-    def predict(self, X, segment, target="final_deformation_cm", return_std=False, strict=False, return_split=False):
+    def predict(self, X, segment, target=PAIN_PROXY, return_std=False, strict=False, return_split=False):
         """Predicted ``target`` for ``segment`` at the query ``X``.
 
         ``X``: a mapping input name -> scalar or array (``scope`` may name a scope), a DataFrame
@@ -212,7 +232,8 @@ class SweepSurrogate:
 
     def predict_frame(self, frame: pd.DataFrame, targets=None, segment=None, strict=False) -> pd.DataFrame:
         """Batch prediction: one row per query row, per target its mean, std, 95 % interval and the
-        std's tissue and surrogate parts (tissue NaN where not modelled; ``tissue_note`` says how).
+        std's tissue and surrogate parts (tissue NaN where not modelled; ``tissue_note`` says how;
+        all NaN where the model has too few runs to know its error, and ``error_note`` says so).
 
         ``frame`` holds input columns (and ``segment`` unless given). Targets a segment has no model
         of are NaN. Columns ``in_domain`` and ``domain_note`` say which rows extrapolate."""
@@ -224,7 +245,7 @@ class SweepSurrogate:
         frame = frame.assign(segment=frame["segment"].astype(str).str.strip().str.lower())
         targets = list(targets or self.targets)
         out = frame.copy()
-        out["in_domain"], out["domain_note"], out["tissue_note"] = True, "", ""
+        out["in_domain"], out["domain_note"], out["tissue_note"], out["error_note"] = True, "", "", ""
         for t in targets:
             for suffix in SUFFIXES:
                 out[t + suffix] = np.nan
@@ -245,6 +266,10 @@ class SweepSurrogate:
                 if gp is None:
                     continue
                 mean, std, std_tissue, std_surrogate = split_predict(gp, domain, Xm, tissue)
+                unknown = error_unknown(self.cv_[seg][t], gp)
+                if unknown:  # no number where the model cannot vouch for it
+                    std = std_tissue = std_surrogate = np.full(len(mean), np.nan)
+                    out.loc[rows.index, "error_note"] += f"{t}: {unknown}. "
                 out.loc[rows.index, t] = mean
                 out.loc[rows.index, t + "_std"] = std
                 out.loc[rows.index, t + "_std_tissue"] = std_tissue
@@ -265,6 +290,13 @@ class SweepSurrogate:
                 lines.append(f"  {target:<22} n {cv['n']:>3}  CV RMSE {cv['rmse']:.3g}  max {cv['max_abs_error']:.3g}  "
                              f"95% coverage {100 * cv['coverage_95']:.0f} %  Q2 {cv['q2'] if cv['q2'] is None else round(cv['q2'], 3)}  "
                              f"scatter sd {gp.noise_std:.2g}  length scales ({scales})")
+                scatter = self.scatter_.get(seg, {}).get(target)
+                if scatter:
+                    lines.append(f"  {'':<22} noise floor {scatter['sd']:.2g} (scatter of {scatter['pairs']} replicate "
+                                 f"pairs; their offset {scatter['offset']:+.2g})")
+                unknown = error_unknown(cv, gp)
+                if unknown:
+                    lines.append(f"  {'':<22} {unknown}: its sd, intervals and probabilities are not printed")
             for target, why in self.skipped_[seg].items():
                 lines.append(f"  {target:<22} no model: {why}")
         if getattr(self, "tissue_", None) is not None and any(tissue_inputs(d) for d in self.domains_.values()):

@@ -8,11 +8,11 @@ from matplotlib.figure import Figure
 from colonsim.errors import ColonsimError
 from colonsim.surrogate.recommend import default_scopes
 from colonsim.surrogate.tissue import tissue_inputs
-from colonsim.surrogate.table import INPUT_LABELS, TARGET_LABELS, scope_diameter_mm
+from colonsim.surrogate.table import INPUT_LABELS, PAIN_PROXY, TARGET_LABELS, scope_diameter_mm
 from colonsim.surrogate.validation import Z95
 
 
-def prediction_figure(model, segment, vs, inputs: dict, target="final_deformation_cm", scopes=None, points=120,
+def prediction_figure(model, segment, vs, inputs: dict, target=PAIN_PROXY, scopes=None, points=120,
                       strict=False) -> Figure:
     """Predicted ``target`` of ``segment`` against the input ``vs`` over its training range.
 

@@ -31,7 +31,7 @@ from scipy.special import ndtr
 
 from colonsim.errors import ColonsimError
 from colonsim.surrogate.tissue import plan, trend_components
-from colonsim.surrogate.table import NAMED_SCOPES_MM, STANDARD_SCOPE, scope_diameter_mm, target_unit
+from colonsim.surrogate.table import NAMED_SCOPES_MM, PAIN_PROXY, STANDARD_SCOPE, scope_diameter_mm, target_unit
 from colonsim.surrogate.validation import Z95
 
 
@@ -42,7 +42,7 @@ def default_scopes(domain):
     return sorted(table, key=lambda name: table[name])  # thinnest first
 
 
-def recommend(model, segment, inputs: dict, scopes=None, target="final_deformation_cm", reference=None,
+def recommend(model, segment, inputs: dict, scopes=None, target=PAIN_PROXY, reference=None,
               strict=False, n_draws=20000, seed=0) -> dict:
     """Scopes for a patient (``inputs`` without the scope) ranked by predicted ``target``.
 
@@ -95,7 +95,14 @@ def recommend(model, segment, inputs: dict, scopes=None, target="final_deformati
              "p_less_than_reference": None if i == r else float(p_less[i]),
              "p_less_than_reference_with_cv_error": None if i == r else float(p_less_cv[i]),
              "in_domain": bool(inside[i]), "domain_note": notes[i]} for i in order]
-    return {"segment": domain.segment, "target": target, "inputs": patient,
+    unknown = model.error_unknown(domain.segment, target)
+    if unknown:  # the order stands by the means; no spread or probability the model cannot vouch for
+        for row in rows:
+            row.update({k: None for k in ("std", "std_tissue", "std_surrogate", "low95", "high95", "p_best",
+                                          "p_less_than_reference", "p_less_than_reference_with_cv_error")})
+        p_ranking = p_ranking_cv = None
+    return {"segment": domain.segment, "target": target, "inputs": patient, "error_unknown": unknown,
+            "n_runs": int(model.cv_[domain.segment][target]["n"]),
             "reference": reference, "ranking": [scopes[i] for i in order], "p_ranking": p_ranking,
             "cv_rmse": cv_rmse, "p_ranking_with_cv_error": p_ranking_cv, "scopes": rows,
             "uncertainty": "joint GP posterior of the smooth trend at the scopes (covariance included); "
@@ -115,6 +122,13 @@ def _mixture_draws(means, covs, n_draws, seed):
 def format_recommendation(rec) -> str:
     """The recommendation as a few lines of text."""
     unit = target_unit(rec["target"])
+    if rec.get("error_unknown"):
+        lines = [f"{rec['segment'].upper()}, {rec['target']}: " + " < ".join(s.upper() for s in rec["ranking"])
+                 + f" by the predicted means; no probability or interval: the model rests on {rec['n_runs']} runs, "
+                 f"{rec['error_unknown']}"]
+        lines += [f"  {s['rank']}. {s['scope'].upper():>5} ({s['diameter_mm']:g} mm): {s['mean']:.3g} {unit}"
+                  + ("" if s["in_domain"] else f"  OUTSIDE the training domain: {s['domain_note']}") for s in rec["scopes"]]
+        return "\n".join(lines)
     lines = [f"{rec['segment'].upper()}, {rec['target']}: " + " < ".join(s.upper() for s in rec["ranking"])
              + f"  (probability this order holds: {100 * rec['p_ranking']:.0f} %; "
              f"{100 * rec['p_ranking_with_cv_error']:.0f} % allowing the surrogate's cross-validated error of "
@@ -133,5 +147,5 @@ def format_recommendation(rec) -> str:
         split = ", ".join(f"{s['scope'].upper()} tissue {s['std_tissue']:.2g}, surrogate {s['std_surrogate']:.2g}"
                           for s in rec["scopes"])
         lines.append(f"  uncertainty split (sd, {unit}): {split}; {tissue['note']}")
-    lines.append(f"  ({rec['uncertainty']})")
+    lines.append(f"  ({rec['uncertainty']}; the model rests on {rec['n_runs']} runs)")
     return "\n".join(lines)

@@ -27,7 +27,7 @@ from colonsim.surrogate.model import SweepSurrogate
 from colonsim.surrogate.tissue import TissueDistribution
 
 FORMAT = "colonsim-surrogate"
-FORMAT_VERSION = "1.1"
+FORMAT_VERSION = "1.2"
 ARRAYS = ("X_train", "y_train", "alpha", "L")
 
 
@@ -63,6 +63,7 @@ def save_surrogate(model: SweepSurrogate, path, source=None):
                 "y_mean": gp.y_mean_, "y_scale": gp.y_scale_, "noise_std": gp.noise_std,
                 "log_marginal_likelihood": gp.log_marginal_likelihood_, "n_train": int(len(gp.alpha_)),
                 "cross_validation": model.cv_[seg][target],
+                "noise_floor_sd": gp.noise_floor_sd, "scatter": model.scatter_[seg].get(target),
             }
         segments[seg] = {"domain": domain.to_dict(), "models": entries, "skipped": model.skipped_[seg]}
     doc = {"format": FORMAT, "format_version": FORMAT_VERSION, "colonsim_version": __version__,
@@ -124,14 +125,17 @@ def _read_pair(doc, json_path, npz_path) -> SweepSurrogate:
                                random_state=est["random_state"], threads=est.get("threads", 1))
         model.training_, model.notes_ = doc["training"], list(doc["notes"])
         model.tissue_ = TissueDistribution.from_dict(doc.get("tissue"))  # files of format 1.0 hold none
-        model.domains_, model.models_, model.cv_, model.skipped_ = {}, {}, {}, {}
+        model.domains_, model.models_, model.cv_, model.skipped_, model.scatter_ = {}, {}, {}, {}, {}
         with np.load(npz_path, allow_pickle=False) as arrays:
             for seg, entry in doc["segments"].items():
                 domain = SegmentDomain.from_dict(entry["domain"])
                 model.domains_[seg] = domain
                 model.models_[seg], model.cv_[seg], model.skipped_[seg] = {}, {}, dict(entry["skipped"])
+                model.scatter_[seg] = {}
                 for target, m in entry["models"].items():
-                    gp = GaussianProcess(input_range=(domain.low, domain.high))
+                    # files of format 1.0 and 1.1 hold no floor nor scatter
+                    gp = GaussianProcess(input_range=(domain.low, domain.high),
+                                         noise_floor_sd=float(m.get("noise_floor_sd", 0.0)))
                     gp.x_low_, gp.x_span_ = np.asarray(m["x_low"], dtype=float), np.asarray(m["x_span"], dtype=float)
                     gp.y_mean_, gp.y_scale_ = float(m["y_mean"]), float(m["y_scale"])
                     gp.constant_, gp.noise_level_ = float(m["constant"]), float(m["noise_level"])
@@ -141,6 +145,7 @@ def _read_pair(doc, json_path, npz_path) -> SweepSurrogate:
                         setattr(gp, name + "_", arrays[_key(seg, target, name)])
                     model.models_[seg][target] = gp
                     model.cv_[seg][target] = m["cross_validation"]
+                    model.scatter_[seg][target] = m.get("scatter")
     except (KeyError, TypeError, ValueError, AttributeError, OSError) as exc:
         raise ColonsimError(f"{json_path} or its arrays file is damaged ({type(exc).__name__}: {exc}); "
                             "refit the surrogate") from None

@@ -24,6 +24,7 @@ INPUT_LABELS = {name: catalog.COLUMNS[name].label for name in INPUTS}
 # How the command line spells each input (for messages).
 INPUT_OPTIONS = {name: catalog.COLUMNS[name].option for name in INPUTS}
 TARGETS = catalog.columns(catalog.OUTPUT, surrogate=(catalog.DEFAULT_TARGET,))
+PAIN_PROXY = catalog.PAIN_PROXY  # the output scopes are ranked by (colonsim.catalog)
 TARGET_LABELS = {name: catalog.COLUMNS[name].label
                  for name in catalog.columns(catalog.OUTPUT, surrogate=(catalog.DEFAULT_TARGET, catalog.TARGET))}
 # Columns that are neither inputs nor solver settings: identity and outputs of a run, and the

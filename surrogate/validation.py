@@ -18,19 +18,55 @@ The interval is that of a new simulation result (trend + scatter), the quantity 
 from __future__ import annotations
 
 import numpy as np
+from scipy.stats import chi2
+
 from colonsim.errors import ColonsimError
 from colonsim.surrogate.likelihood import inverse_from_cholesky
 
 Z95 = 1.959963984540054
+NOISE_AT_BOUND = 1.01  # a noise variance within 1 % of its lower bound sits at it
+MIN_CHECKED_RUNS = 10  # fewer: the model cannot vouch for its error (measured, docs/surrogate.md "Too few runs")
 
 
 def metrics(y, mean, std):
-    """RMSE, maximum absolute error, coverage of mean +- 1.96 std, and Q^2 = 1 - SSE / SS."""
+    """RMSE, maximum absolute error, coverage of mean +- 1.96 std, Q^2 = 1 - SSE / SS, and the root
+    mean square of the standardized errors ``(y - mean) / std`` (about 1 when the sd is right)."""
     err = np.asarray(mean) - np.asarray(y)
     ss = float(np.sum((y - np.mean(y)) ** 2))
     return {"n": int(len(y)), "rmse": float(np.sqrt(np.mean(err**2))), "max_abs_error": float(np.max(np.abs(err))),
             "coverage_95": float(np.mean(np.abs(err) <= Z95 * np.asarray(std))),
-            "mean_std": float(np.mean(std)), "q2": float(1.0 - np.sum(err**2) / ss) if ss > 0 else None}
+            "mean_std": float(np.mean(std)), "q2": float(1.0 - np.sum(err**2) / ss) if ss > 0 else None,
+            "z_rms": float(np.sqrt(np.mean((err / np.asarray(std)) ** 2)))}
+
+
+def error_unknown(cv: dict, gp) -> str | None:
+    """Why the model cannot state its error, or None when it can (docs/surrogate.md, "Too few runs").
+
+    ``cv``: its cross-validation metrics; ``gp``: the fitted :class:`GaussianProcess`. The error is
+    unknown when
+
+    - fewer than :data:`MIN_CHECKED_RUNS` runs were predicted without themselves;
+    - the noise sits at the bottom of its range and no replicate runs measured it: the fit
+      explained the runs' scatter by short length scales instead of estimating it, and its
+      intervals are then far too narrow (docs/surrogate.md, "Noise floor"), which leave-one-out with
+      those hyperparameters does not reveal;
+    - the standardized cross-validated errors are larger than the stated sd allows: the sum of
+      their squares above the 95th percentile of a chi-square with as many degrees of freedom (a
+      model whose sd is right exceeds it one time in twenty).
+    """
+    n, z_rms = int(cv["n"]), cv.get("z_rms")
+    if z_rms is None:
+        return "its error was not cross-checked (a model of an older colonsim); refit it"
+    if n < MIN_CHECKED_RUNS:
+        return f"too few runs to know its error ({n} < {MIN_CHECKED_RUNS})"
+    if gp.noise_floor_sd <= 0 and gp.noise_level_ <= NOISE_AT_BOUND * gp.noise_bounds[0]:
+        return ("too few runs to know its error: the fit put the run-to-run scatter at the bottom of its range instead "
+                "of estimating it; measure it with replicate runs (fit --replicates)")
+    limit = float(np.sqrt(chi2.ppf(0.95, n) / n))
+    if z_rms > limit:
+        return (f"too few runs to know its error: its cross-validated errors are {z_rms:.1f} times the sd it states "
+                f"(at most {limit:.2f} with {n} runs)")
+    return None
 
 
 def loo_predictions(gp):

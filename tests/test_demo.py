@@ -26,11 +26,21 @@ def test_demo_runs_every_workflow_and_writes_one_folder(tmp_path, capsys):
     table = pd.read_parquet(out / "sweep" / "results.parquet")
     assert len(table) == 12 and (table["status"] == "ok").all()
     assert set(table["diameter_mm"]) == {23.0, 36.0} and set(table["friction"]) == {0.0, 0.1}
+    replicates = pd.read_parquet(out / "replicates" / "results.parquet")
+    assert len(replicates) == 4 and set(replicates["element_size_mm"]) == {6.975}
     assert (out / "surrogate.json").is_file() and (out / "surrogate.npz").is_file()
+    doc = json.loads((out / "surrogate.json").read_text())
+    assert doc["segments"]["rsj"]["models"]["max_deformation_cm"]["scatter"]["pairs"] == 4
     recs = json.loads((out / "recommendations.json").read_text())
     assert [r["patient"]["region"] for r in recs] == ["african", "european"]
+    summary = text.split("== summary")[1]
+    assert "largest colon deformation over the run" in summary and "rests on 12 runs" in summary
     for rec in recs:
-        assert sorted(rec["ranking"]) == ["pdc", "sdc", "utc"] and 0.0 <= rec["p_ranking"] <= 1.0
+        assert rec["target"] == "max_deformation_cm" and rec["n_runs"] == 12
+        # a number where the model vouches for its error, else the reason instead of one
+        assert (rec["error_unknown"] is None) == (rec["p_ranking"] is not None)
+        assert rec["p_ranking"] is None or 0.0 <= rec["p_ranking"] <= 1.0
+        assert sorted(rec["ranking"]) == ["pdc", "sdc", "utc"]
         means = [s["mean"] for s in rec["scopes"]]
         assert means == sorted(means)  # the ranking is by predicted deformation
     report = (out / "report.md").read_text()

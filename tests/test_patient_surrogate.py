@@ -16,7 +16,7 @@ def _patients(files, shift_cm):
     for i, (path, shift) in enumerate(zip(files, shift_cm)):
         t = synthetic_sweep(n_runs=12, segments=("rsj",), n_failed=0, seed=i)
         t["segment"], t["centerline"], t["key"] = "patient", path, [f"p{i}-{k}" for k in range(len(t))]
-        t["final_deformation_cm"] += shift
+        t["max_deformation_cm"] += shift
         frames.append(t)
     rsj = synthetic_sweep(n_runs=12, segments=("rsj",), n_failed=0, seed=9)
     rsj["centerline"] = ""
@@ -25,7 +25,7 @@ def _patients(files, shift_cm):
 
 def test_each_centerline_file_gets_its_own_model():
     table = _patients(["/data/a/anna.csv", "C:\\cohort\\bert.csv"], [0.0, 2.0])
-    model = SweepSurrogate(targets=("final_deformation_cm",), n_restarts=0).fit(table)
+    model = SweepSurrogate(targets=("max_deformation_cm",), n_restarts=0).fit(table)
     assert set(model.domains_) == {"patient:anna", "patient:bert", "rsj"}
     query = {"scope_diameter_mm": 11.0, "diameter_mm": 30.0, "friction": 0.05}
     anna = model.predict(query, "patient:anna")[0]

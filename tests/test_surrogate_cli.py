@@ -15,7 +15,7 @@ def fitted(tmp_path_factory):
     folder = tmp_path_factory.mktemp("surrogate")
     synthetic_sweep(design="grid", noise_cm=0.02, seed=1).to_parquet(folder / "results.parquet")
     code = main(["surrogate", "fit", str(folder / "results.parquet"), "-o", str(folder / "model"), "--restarts", "0",
-                 "--targets", "final_deformation_cm", "point_C_cm", "peak_contact_force_N"])
+                 "--targets", "max_deformation_cm", "point_C_cm", "peak_contact_force_N"])
     assert code == 0
     return folder
 
@@ -33,8 +33,8 @@ def test_predict_json(fitted, capsys):
     rows = json.loads(capsys.readouterr().out)["predictions"]
     assert [r["scope"] for r in rows] == ["utc", "sdc"] and all(r["in_domain"] for r in rows)
     assert rows[0]["friction"] == 0.05 and rows[0]["angle_deg"] == 40.0
-    assert rows[0]["final_deformation_cm"] < rows[1]["final_deformation_cm"]
-    assert rows[0]["final_deformation_cm_low95"] < rows[0]["final_deformation_cm"] < rows[0]["final_deformation_cm_high95"]
+    assert rows[0]["max_deformation_cm"] < rows[1]["max_deformation_cm"]
+    assert rows[0]["max_deformation_cm_low95"] < rows[0]["max_deformation_cm"] < rows[0]["max_deformation_cm_high95"]
     assert "point_C_cm" not in rows[0]  # undefined for RSF
 
 
@@ -48,7 +48,7 @@ def test_predict_batch_csv(fitted, tmp_path, capsys):
     assert len(table) == 3 and table["in_domain"].all()
     assert list(table["diameter_mm"][:2]) == [23.0, 36.0] and table.loc[2, "angle_deg"] == 45.0
     assert table.loc[:1, "point_C_cm"].notna().all() and pd.isna(table.loc[2, "point_C_cm"])
-    assert "final_deformation_cm" in capsys.readouterr().out
+    assert "max_deformation_cm" in capsys.readouterr().out
 
 
 def test_recommend_and_plot(fitted, tmp_path, capsys):

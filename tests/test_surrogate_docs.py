@@ -36,6 +36,7 @@ def blocks(kind):
 def workdir(tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)
     synthetic_sweep(design="grid").to_parquet(tmp_path / "results.parquet")
+    synthetic_sweep(n_runs=30, n_failed=0, seed=7).to_parquet(tmp_path / "held_out.parquet")
     csv = next(b for b in blocks("") if b.startswith("segment,"))
     (tmp_path / "queries.csv").write_text(csv)
     return tmp_path
@@ -46,7 +47,8 @@ def test_doc_commands_run(workdir, capsys):
     assert len(commands) >= 8
     for command in commands:
         assert main(shlex.split(command)[1:]) == 0, command
-    for name in ("model.json", "model.npz", "predictions.csv", "recommendation.json", "rsf_angle.png"):
+    for name in ("model.json", "model.npz", "predictions.csv", "recommendation.json", "rsf_angle.png",
+                 "reliability.png"):
         assert (workdir / name).is_file()
     capsys.readouterr()
     quoted = blocks("console")[1].splitlines()

@@ -20,7 +20,7 @@ from colonsim.surrogate.store import load_surrogate, save_surrogate
 from colonsim.surrogate.synthetic import synthetic_deformation, synthetic_sweep
 from colonsim.surrogate.table import NAMED_SCOPES_MM
 
-TARGETS = ("final_deformation_cm", "point_A_cm", "peak_contact_force_N")
+TARGETS = ("max_deformation_cm", "point_A_cm", "peak_contact_force_N")
 
 
 @pytest.fixture(scope="module")
@@ -64,10 +64,10 @@ def test_predictions_recover_the_synthetic_function(model):
     q = {"scope_diameter_mm": rng.uniform(9.2, 12.8, 200), "angle_deg": rng.uniform(0, 45, 200),
          "friction": rng.uniform(0, 0.1, 200)}
     mean, std = model.predict(q, "rsf", return_std=True)
-    truth = synthetic_deformation(q["scope_diameter_mm"], 36.0, q["angle_deg"], q["friction"])
+    truth = 1.05 * synthetic_deformation(q["scope_diameter_mm"], 36.0, q["angle_deg"], q["friction"])  # max = 1.05 final
     assert np.sqrt(np.mean((mean - truth) ** 2)) < 0.05  # deformations 2.4-5.3 cm, noise 0.02 cm
     assert np.mean(np.abs(mean - truth) <= 1.96 * std) > 0.85
-    cv = model.cv_["rsf"]["final_deformation_cm"]
+    cv = model.cv_["rsf"]["max_deformation_cm"]
     assert cv["n"] == 26 and cv["rmse"] < 0.06 and 0.8 <= cv["coverage_95"] <= 1.0
 
 
@@ -92,9 +92,9 @@ def test_out_of_domain_warns_and_strict_raises(model):
 def test_save_load_round_trip_without_pickle(model, tmp_path):
     json_path, npz_path = save_surrogate(model, tmp_path / "model", source="results.parquet")
     doc = json.loads(json_path.read_text())
-    assert doc["format"] == "colonsim-surrogate" and doc["format_version"] == "1.1"
+    assert doc["format"] == "colonsim-surrogate" and doc["format_version"] == "1.2"
     assert doc["segments"]["rsj"]["domain"]["fixed"]["angle_deg"] == 0.0
-    assert set(doc["segments"]["rsj"]["models"]["final_deformation_cm"]["cross_validation"]) >= {
+    assert set(doc["segments"]["rsj"]["models"]["max_deformation_cm"]["cross_validation"]) >= {
         "rmse", "max_abs_error", "coverage_95"}
     with zipfile.ZipFile(npz_path) as z:
         assert all(name.endswith(".npy") for name in z.namelist())
@@ -115,7 +115,7 @@ def test_save_load_round_trip_without_pickle(model, tmp_path):
 
 def test_load_refuses_foreign_or_mismatched_files(model, tmp_path):
     save_surrogate(model, tmp_path / "a")
-    save_surrogate(SweepSurrogate(targets=("final_deformation_cm",), n_restarts=0)
+    save_surrogate(SweepSurrogate(targets=("max_deformation_cm",), n_restarts=0)
                    .fit(synthetic_sweep(design="grid", segments=("rsj",))), tmp_path / "b")
     (tmp_path / "b.npz").replace(tmp_path / "a.npz")
     with pytest.raises(ColonsimError, match="does not belong"):
@@ -137,17 +137,17 @@ def test_failed_runs_and_nan_targets_are_left_out():
 
 def test_rows_left_out_are_counted_with_the_reason():
     table = synthetic_sweep(n_runs=12, segments=("rsj",), n_failed=0, seed=4)
-    table.loc[2, "final_deformation_cm"] = np.inf
-    table.loc[5, "final_deformation_cm"] = np.nan
-    m = SweepSurrogate(targets=("final_deformation_cm",), n_restarts=0).fit(table)
-    assert m.cv_["rsj"]["final_deformation_cm"]["n"] == 10
-    assert ("rsj final_deformation_cm: 2 of 12 successful runs left out (1 with an infinite value and 1 without "
+    table.loc[2, "max_deformation_cm"] = np.inf
+    table.loc[5, "max_deformation_cm"] = np.nan
+    m = SweepSurrogate(targets=("max_deformation_cm",), n_restarts=0).fit(table)
+    assert m.cv_["rsj"]["max_deformation_cm"]["n"] == 10
+    assert ("rsj max_deformation_cm: 2 of 12 successful runs left out (1 with an infinite value and 1 without "
             "a value (NaN)), 10 used") in m.notes_
-    assert "note: rsj final_deformation_cm: 2 of 12" in m.report()
+    assert "note: rsj max_deformation_cm: 2 of 12" in m.report()
 
 
 def test_an_input_missing_from_the_table_is_noted_and_a_query_setting_it_refused(grid_table):
-    m = SweepSurrogate(targets=("final_deformation_cm",), n_restarts=0).fit(grid_table.drop(columns=["diameter_mm"]))
+    m = SweepSurrogate(targets=("max_deformation_cm",), n_restarts=0).fit(grid_table.drop(columns=["diameter_mm"]))
     assert any("no column diameter_mm" in n for n in m.notes_)
     query = {"scope": "sdc", "friction": 0.0}
     m.predict(query, "rsj")  # without the input: answered
@@ -155,7 +155,7 @@ def test_an_input_missing_from_the_table_is_noted_and_a_query_setting_it_refused
         m.predict({**query, "diameter_mm": 23.0}, "rsj")
     # a batch whose diameter column is empty sets nothing
     out = m.predict_frame(pd.DataFrame({"segment": ["rsj"], "scope": ["sdc"], "friction": [0.0], "diameter_mm": [np.nan]}))
-    assert np.isfinite(out["final_deformation_cm"]).all()
+    assert np.isfinite(out["max_deformation_cm"]).all()
 
 
 def test_a_failed_save_leaves_the_earlier_model_untouched(model, tmp_path):
@@ -163,7 +163,7 @@ def test_a_failed_save_leaves_the_earlier_model_untouched(model, tmp_path):
     json_path, npz_path = save_surrogate(model, tmp_path / "model")
     before = {p.name: p.read_bytes() for p in tmp_path.iterdir()}
     broken = SweepSurrogate(targets=TARGETS, n_restarts=0).fit(synthetic_sweep(design="grid", noise_cm=0.05, seed=2))
-    broken.cv_["rsj"]["final_deformation_cm"]["rmse"] = float("inf")  # a value JSON cannot hold
+    broken.cv_["rsj"]["max_deformation_cm"]["rmse"] = float("inf")  # a value JSON cannot hold
     for path in (tmp_path / "model", tmp_path / "fresh"):
         with pytest.raises(ColonsimError, match=r"cross_validation.rmse is inf, which JSON cannot hold"):
             save_surrogate(broken, path)
@@ -173,15 +173,15 @@ def test_a_failed_save_leaves_the_earlier_model_untouched(model, tmp_path):
 
 def test_outputs_that_overflow_the_fit_are_refused():
     table = synthetic_sweep(n_runs=12, segments=("rsj",), n_failed=0, seed=4)
-    table.loc[3, "final_deformation_cm"] = 1e300
-    with pytest.raises(ColonsimError, match="rsj final_deformation_cm: the fit is not finite"):
-        SweepSurrogate(targets=("final_deformation_cm",), n_restarts=0).fit(table)
+    table.loc[3, "max_deformation_cm"] = 1e300
+    with pytest.raises(ColonsimError, match="rsj max_deformation_cm: the fit is not finite"):
+        SweepSurrogate(targets=("max_deformation_cm",), n_restarts=0).fit(table)
 
 
 def test_varying_solver_setting_is_noted():
     table = synthetic_sweep(n_runs=10, segments=("rsj",), seed=2)
     table.loc[::2, "element_size_mm"] = 4.0
-    m = SweepSurrogate(targets=("final_deformation_cm",), n_restarts=0).fit(table)
+    m = SweepSurrogate(targets=("max_deformation_cm",), n_restarts=0).fit(table)
     assert any("element_size_mm vary" in n for n in m.notes_)
 
 
@@ -206,15 +206,15 @@ def test_recommend_ranks_by_diameter_with_confidence(model):
     assert by_scope["utc"]["p_less_than_reference"] > 0.99 and by_scope["sdc"]["p_less_than_reference"] is None
     assert rec["p_ranking"] > 0.99 and by_scope["utc"]["p_best"] > 0.99
     # adding the cross-validated error per scope can only make the order less sure
-    assert rec["cv_rmse"] == pytest.approx(model.cv_["rsj"]["final_deformation_cm"]["rmse"])
+    assert rec["cv_rmse"] == pytest.approx(model.cv_["rsj"]["max_deformation_cm"]["rmse"])
     assert 0.0 < rec["p_ranking_with_cv_error"] <= rec["p_ranking"] + 0.01
     assert by_scope["utc"]["p_less_than_reference_with_cv_error"] <= by_scope["utc"]["p_less_than_reference"] + 0.01
 
 
 def test_recommend_is_unsure_when_the_scope_does_not_matter():
     table = synthetic_sweep(design="grid", segments=("rsj",), noise_cm=0.05, seed=3)
-    table["final_deformation_cm"] = 3.0 + 0.02 * table["diameter_mm"] + np.random.default_rng(0).normal(0, 0.05, len(table))
-    m = SweepSurrogate(targets=("final_deformation_cm",), n_restarts=0).fit(table)
+    table["max_deformation_cm"] = 3.0 + 0.02 * table["diameter_mm"] + np.random.default_rng(0).normal(0, 0.05, len(table))
+    m = SweepSurrogate(targets=("max_deformation_cm",), n_restarts=0).fit(table)
     rec = recommend(m, "rsj", {"diameter_mm": 30.0, "friction": 0.05})
     p = {s["scope"]: s["p_less_than_reference"] for s in rec["scopes"]}
     assert 0.05 < p["utc"] < 0.95 and rec["p_ranking"] < 0.9
@@ -230,8 +230,8 @@ def test_predict_frame_batch(model):
     assert out.loc[2, "scope_diameter_mm"] == 10.5
     assert np.isnan(out.loc[1, "point_A_cm"]) and np.isfinite(out.loc[0, "point_A_cm"])
     single = model.predict({"scope": "sdc", "angle_deg": 30.0, "friction": 0.05}, "rsf", return_std=True)
-    assert out.loc[1, "final_deformation_cm"] == pytest.approx(single[0][0])
-    assert out.loc[1, "final_deformation_cm_high95"] == pytest.approx(single[0][0] + 1.959964 * single[1][0])
+    assert out.loc[1, "max_deformation_cm"] == pytest.approx(single[0][0])
+    assert out.loc[1, "max_deformation_cm_high95"] == pytest.approx(single[0][0] + 1.959964 * single[1][0])
 
 
 def test_scope_names_fill_missing_diameters(model):

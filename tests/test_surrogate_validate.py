@@ -1,0 +1,168 @@
+"""Scoring a surrogate on held-out runs, and the noise floor from replicate runs.
+
+Tables are SYNTHETIC (colonsim.surrogate.synthetic: a known smooth function plus Gaussian noise of
+a known sd): the tests check the machinery, not physics.
+"""
+
+import json
+
+import numpy as np
+import pytest
+
+from colonsim.cli import main
+from colonsim.errors import ColonsimError
+from colonsim.surrogate.holdout import score
+from colonsim.surrogate.model import SweepSurrogate
+from colonsim.surrogate.replicates import replicate_scatter
+from colonsim.surrogate.synthetic import synthetic_outputs, synthetic_sweep
+from colonsim.surrogate.table import successful_runs
+
+TARGET = "max_deformation_cm"
+NOISE = 0.05  # cm, the synthetic scatter
+
+
+def rsj(n_runs, seed, noise=NOISE):
+    return synthetic_sweep(n_runs=n_runs, segments=("rsj",), noise_cm=noise, n_failed=0, seed=seed)
+
+
+def replicates_of(table, n, seed, noise=NOISE):
+    """The first ``n`` cases of ``table`` run again (another mesh): the same inputs, new scatter of
+    sd ``noise`` and an offset of 0.02 cm in every run."""
+    again = table.iloc[:n].copy()
+    clean = synthetic_outputs("rsj", again["scope_diameter_mm"], again["diameter_mm"], again["angle_deg"],
+                              again["friction"])[TARGET]
+    again[TARGET] = clean + 0.02 + np.random.default_rng(seed).normal(0.0, noise, n)
+    again["element_size_mm"] = 2.8
+    again["key"] = again["key"] + "-fine"  # another run: another key
+    return again
+
+
+@pytest.fixture(scope="module")
+def train():
+    return rsj(24, seed=11)
+
+
+@pytest.fixture(scope="module")
+def test_table():
+    return rsj(40, seed=12)
+
+
+@pytest.fixture(scope="module")
+def floored(train):
+    return SweepSurrogate(targets=(TARGET,), n_restarts=1, replicates=replicates_of(train, 12, seed=13)).fit(train)
+
+
+def test_replicate_pairs_measure_the_scatter(train, floored):
+    s = floored.scatter_["rsj"][TARGET]
+    assert s["pairs"] == 12 and s["unpaired"] == 0
+    assert 0.6 * NOISE < s["sd"] < 1.5 * NOISE  # 11 degrees of freedom: +-30 % at 2 sd
+    assert s["offset"] == pytest.approx(0.02, abs=0.05)
+    assert floored.models_["rsj"][TARGET].noise_std >= s["sd"] * (1 - 1e-6)  # the floor holds
+
+
+def test_too_few_replicate_pairs_is_an_error(train):
+    reps = replicates_of(train, 2, seed=13)
+    runs = successful_runs(train, "rsj")
+    with pytest.raises(ColonsimError, match=r"2 pair\(s\) of runs of one case at two solver settings, at least 3"):
+        replicate_scatter(runs, reps, "rsj", ["scope_diameter_mm", "diameter_mm", "friction"], TARGET)
+
+
+def test_heldout_score_is_calibrated_with_the_right_noise(floored, test_table):
+    s = score(floored, test_table, TARGET)
+    assert s["n"] == 40 and s["n_train"] == 24
+    assert 0.85 <= s["coverage"]["95"] <= 1.0 and 0.3 <= s["coverage"]["50"] <= 0.7
+    assert abs(s["z_mean"]) < 0.5 and 0.6 < s["z_sd"] < 1.5
+    assert s["orders"]["held"] >= s["orders"]["mean_stated"] - 0.05
+
+
+def test_heldout_score_exposes_an_overconfident_model(floored):
+    """Held-out runs with ten times the scatter the model learned: the same score says so."""
+    noisy = rsj(40, seed=12, noise=10 * NOISE)
+    s = score(floored, noisy, TARGET)
+    assert s["coverage"]["95"] < 0.7 and s["z_sd"] > 2.0
+    assert s["orders"]["held"] < s["orders"]["mean_stated"] - 0.05
+
+
+def test_validate_command(floored, test_table, tmp_path, capsys):
+    from colonsim.surrogate.store import save_surrogate
+
+    save_surrogate(floored, tmp_path / "model")
+    test_table.to_parquet(tmp_path / "test.parquet")
+    assert main(["surrogate", "validate", str(tmp_path / "model.json"), str(tmp_path / "test.parquet"),
+                 "--plot", str(tmp_path / "reliability.png"), "-o", str(tmp_path / "scores.json")]) == 0
+    text = capsys.readouterr().out
+    assert "coverage of the 50 / 90 / 95 % intervals" in text and "standardized error: mean" in text
+    assert (tmp_path / "reliability.png").stat().st_size > 10_000
+    doc = json.loads((tmp_path / "scores.json").read_text())
+    assert doc["scores"][0]["target"] == TARGET and len(doc["scores"][0]["reliability"]["observed"]) == 19
+
+
+@pytest.mark.parametrize("drop,message", [("diameter_mm", "lacks the input column(s) diameter_mm"),
+                                          (TARGET, "holds none of the outputs")])
+def test_validate_refuses_a_table_without_the_model_inputs(floored, test_table, tmp_path, capsys, drop, message):
+    from colonsim.surrogate.store import save_surrogate
+
+    save_surrogate(floored, tmp_path / "model")
+    test_table.drop(columns=[drop]).to_parquet(tmp_path / "test.parquet")
+    assert main(["surrogate", "validate", str(tmp_path / "model.json"), str(tmp_path / "test.parquet")]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.startswith("colonsim: error:") and message in err and len(err.splitlines()) == 1
+
+
+# -- too few runs to know its error -----------------------------------------------------------------
+def test_error_is_known_with_enough_runs_and_an_estimated_noise(train):
+    from colonsim.surrogate.recommend import format_recommendation, recommend
+
+    model = SweepSurrogate(targets=(TARGET,), n_restarts=1).fit(train)
+    assert model.error_unknown("rsj", TARGET) is None
+    rec = recommend(model, "rsj", {"diameter_mm": 30.0, "friction": 0.05})
+    assert rec["p_ranking"] is not None and all(s["low95"] is not None for s in rec["scopes"])
+    assert "probability this order holds" in format_recommendation(rec)
+
+
+def test_too_few_runs_says_so_instead_of_a_number(train, tmp_path, capsys):
+    from colonsim.surrogate.recommend import format_recommendation, recommend
+    from colonsim.surrogate.store import save_surrogate
+
+    model = SweepSurrogate(targets=(TARGET,), n_restarts=1).fit(train.iloc[:6])
+    assert "too few runs to know its error (6 < 10)" == model.error_unknown("rsj", TARGET)
+    rec = recommend(model, "rsj", {"diameter_mm": 30.0, "friction": 0.05})
+    assert rec["p_ranking"] is None and all(s["std"] is None and s["p_best"] is None for s in rec["scopes"])
+    text = format_recommendation(rec)
+    assert "no probability or interval: the model rests on 6 runs" in text and "%" not in text
+    save_surrogate(model, tmp_path / "model")
+    assert main(["predict", str(tmp_path / "model.json"), "--diameter", "30", "--friction", "0.05", "--scope",
+                 "pdc"]) == 0
+    out = capsys.readouterr().out
+    assert "(no interval: too few runs to know its error (6 < 10))" in out and "+-" not in out.split("\n")[1]
+
+
+def test_noise_at_its_bound_is_not_an_estimate_unless_replicates_measured_it():
+    """Runs without scatter: the fit puts the noise at the bottom of its range, which says nothing
+    about a simulation's scatter; replicate runs that measure it make the error known."""
+    clean = rsj(24, seed=11, noise=0.0)
+    model = SweepSurrogate(targets=(TARGET,), n_restarts=1).fit(clean)
+    assert "bottom of its range" in model.error_unknown("rsj", TARGET)
+    measured = SweepSurrogate(targets=(TARGET,), n_restarts=1,
+                              replicates=replicates_of(clean, 8, seed=3, noise=0.01)).fit(clean)
+    assert measured.error_unknown("rsj", TARGET) is None
+
+
+def test_cross_validated_errors_larger_than_the_sd_make_the_error_unknown(floored):
+    from colonsim.surrogate.validation import error_unknown
+
+    gp = floored.models_["rsj"][TARGET]
+    cv = dict(floored.cv_["rsj"][TARGET])
+    assert error_unknown(cv, gp) is None and cv["z_rms"] < 1.3
+    assert "1.6 times the sd it states (at most 1.23 with 24 runs)" in error_unknown({**cv, "z_rms": 1.6}, gp)
+
+
+def test_fit_with_replicates_on_the_command_line(train, tmp_path, capsys):
+    train.to_parquet(tmp_path / "train.parquet")
+    replicates_of(train, 5, seed=13).to_parquet(tmp_path / "again.parquet")
+    assert main(["surrogate", "fit", str(tmp_path / "train.parquet"), "-o", str(tmp_path / "model"), "--restarts", "0",
+                 "--targets", TARGET, "--replicates", str(tmp_path / "again.parquet")]) == 0
+    assert "noise floor" in capsys.readouterr().out and "(scatter of 5 replicate pairs" in (
+        main(["surrogate", "info", str(tmp_path / "model.json")]) or capsys.readouterr().out)
+    doc = json.loads((tmp_path / "model.json").read_text())
+    assert doc["segments"]["rsj"]["models"][TARGET]["scatter"]["pairs"] == 5
