@@ -129,7 +129,7 @@ CASES = [
     (["insert", "--diameter", "5", "--out", "{ws}/good_insert"], "diameter_mm = 5.0 is outside"),
     (["insert", "--friction", "inf", "--out", "{ws}/good_insert"], "'inf' is not a finite number"),
     (["insert", "--angle", "nan", "--out", "{ws}/good_insert"], "'nan' is not a finite number"),
-    (["insert", "--friction", "-1", "--out", "{ws}/good_insert"], "friction = -1.0 must lie in [0, 2]"),
+    (["insert", "--friction", "-1", "--out", "{ws}/good_insert"], "friction = -1 is outside [0, 2]"),
     (["insert", "--wall-thickness", "abc", "--out", "{ws}/good_insert"], "'abc' is not a number"),
     (["insert", "--material", "{ws}/missing.json", "--out", "{ws}/good_insert"], "not found"),
     (["insert", "--material", "{ws}/not_json.json", "--out", "{ws}/good_insert"], "not valid JSON"),

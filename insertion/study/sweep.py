@@ -33,7 +33,7 @@ from pathlib import Path
 import pandas as pd
 
 from colonsim.errors import ColonsimError
-from colonsim.files import atomic_path, check_output_folder, write_json
+from colonsim.files import atomic_path, check_output_folder, output_set, write_json
 from colonsim.provenance import code_version
 from colonsim.insertion.case.run_budget import DEFAULT_MAX_STEPS, check_sweep_budget
 from colonsim.insertion.case.scenario import InsertionResult
@@ -148,7 +148,8 @@ class SweepStore:
             folder = Path("runs") / case.key()
             result = InsertionResult(case, outcome["timeseries"], outcome["summary"], snapshots=[], model=None,
                                      final_shape=outcome.get("final_shape"))
-            written = write_insertion(result, self.folder / folder)
+            with output_set(self.folder / "runs") as stage:  # the run's folder whole, or its earlier one kept
+                written = write_insertion(result, stage / case.key())
             path = (folder / written["timeseries"].name).as_posix()
         row = result_row(case, outcome, path)
         self.rows[row["key"]] = row

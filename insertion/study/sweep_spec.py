@@ -63,6 +63,7 @@ import numpy as np
 
 from colonsim.catalog import NAMED_SCOPES
 from colonsim.errors import ColonsimError
+from colonsim.inputs import check_input, read_input_text
 from colonsim.insertion.case.scenario import InsertionCase
 from colonsim.insertion.study.material_samples import MATERIAL_PARAMETERS, sample_materials
 from colonsim.insertion.study.sweep_presets import PRESETS  # re-exported: the presets load_sweep knows
@@ -341,7 +342,7 @@ def _check_materials(cases):
     from colonsim.insertion.engine.material import load_material
 
     for path in sorted({c.material for c in cases if c.material}):
-        load_material(path)
+        load_material(check_input(path, "material file"))
 
 
 def load_sweep(path=None, preset: str | None = None) -> SweepSpec:
@@ -353,6 +354,4 @@ def load_sweep(path=None, preset: str | None = None) -> SweepSpec:
             raise ColonsimError(f"unknown preset {preset!r}; use one of {', '.join(PRESETS)}")
         return parse_sweep(PRESETS[preset], origin=f"preset {preset}")
     path = Path(path)
-    if not path.is_file():
-        raise ColonsimError(f"sweep file {path} not found; give the path of a TOML file or use --preset")
-    return parse_sweep(path.read_text(encoding="utf-8"), base=path.parent, origin=str(path))
+    return parse_sweep(read_input_text(path, "sweep file"), base=path.parent, origin=str(path))
