@@ -6,7 +6,7 @@ from pathlib import Path
 
 from colonsim.errors import ColonsimError
 from colonsim.files import check_output_folder
-from colonsim.options import finite_float, output_folder, positive_int
+from colonsim.options import finite_float, output_folder, positive_int, worker_count
 from colonsim.insertion.case.run_budget import DEFAULT_MAX_STEPS
 from colonsim.workflows import available_cores
 
@@ -21,7 +21,7 @@ def add_parser(sub):
     p.add_argument("spec", nargs="?", type=Path, help="sweep TOML file")
     p.add_argument("--preset", help="thesis (the source's 39 insertions), validation (the validation report's "
                                     "24 extra runs) or smoke (3 fast runs)")
-    p.add_argument("--workers", type=positive_int, default=None,
+    p.add_argument("--workers", type=worker_count, default=None,
                    help=f"local worker processes, one Numba thread each (default: the cores, {available_cores()} here)")
     p.add_argument("--scheduler", metavar="ADDR",
                    help="run on a Dask distributed cluster, e.g. tcp://HOST:8786 (workers: dask worker ADDR --nthreads 1)")
@@ -92,7 +92,10 @@ def cmd_sweep(args):
     if args.scheduler is not None and args.workers is not None:
         raise ColonsimError("--workers is for local runs; a Dask cluster (--scheduler) has its own workers")
     if args.scheduler is not None and not args.dry_run:
+        from colonsim.scheduler_address import check_scheduler
+
         dask_distributed()  # a missing dask fails before the sweep is announced or anything written
+        check_scheduler(args.scheduler)  # so does an address where no scheduler answers (within seconds)
     workers = available_cores() if args.workers is None else args.workers
     settings = _adaptive_settings(args, workers)
     spec = load_sweep(args.spec, args.preset)

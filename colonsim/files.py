@@ -109,6 +109,14 @@ def write_failure(exc: OSError, target, unchanged=True) -> ColonsimError:
     return ColonsimError(f"cannot write {_final(target)}: {cause}; {fix}{kept}")
 
 
+def os_failure(exc: OSError) -> ColonsimError:
+    """One line for an OSError that reached the command line: the cause, the file, what to do."""
+    if exc.errno in _WRITE_FAILURES:
+        return write_failure(exc, exc.filename or "a result file", unchanged=False)
+    where = f" ({_final(exc.filename)})" if exc.filename else ""
+    return ColonsimError(f"{exc.strerror or type(exc).__name__}{where}; check the file, the disk and the options")
+
+
 def _final(path) -> Path:
     """Where a file being written into a staging folder (:func:`output_set`) will end up."""
     path = Path(path)

@@ -29,8 +29,10 @@ TABLE_MAX_BYTES = 512 * 2**20
 MESH_MAX = (64, 24)
 # Simulated displacement points along a curve (default 20): each is a nonlinear solve per evaluation.
 POINTS_RANGE = (5, 200)
-# Specimen geometry in mm (free length, width, wall thickness): a strip of tissue, not a cell or a road.
-GEOMETRY_RANGES_MM = {"length": (1.0, 1000.0), "width": (0.5, 200.0), "thickness": (0.05, 50.0)}
+# Specimen geometry in mm (free length, width, wall thickness): wide bounds that only keep the
+# arithmetic finite (1e-300 mm underflows the strain); the reader's own checks say more about
+# values inside them (a thickness typed in metres, a strip wider than long).
+GEOMETRY_RANGES_MM = {"length": (1e-2, 1e4), "width": (1e-3, 1e4), "thickness": (1e-4, 1e3)}
 
 # -- processes ----------------------------------------------------------------------------------
 # Local worker processes: each loads the solver (~300 MB); more than a few per core only costs memory.
@@ -76,6 +78,6 @@ def check_mesh(name, mesh):
 def check_geometry_mm(quantity, value, given_as="{}"):
     """A specimen dimension ``quantity`` (length, width, thickness) in mm within :data:`GEOMETRY_RANGES_MM`."""
     low, high = GEOMETRY_RANGES_MM[quantity]
-    if not low <= value <= high:  # NaN fails too
+    if value > 0 and not low <= value <= high:  # zero and negative values: the reader says more
         raise ColonsimError(f"{given_as.format(quantity)} {value:g} mm is outside {low:g}-{high:g} mm; give the "
                             f"specimen's {quantity} in mm")

@@ -163,6 +163,8 @@ def calibrate(request: CalibrationRequest, out: Path) -> list:
     """Load the curves ``request`` names, calibrate, write results into ``out``; return the results."""
     from colonsim.files import check_output_folder, output_set
     from colonsim.laws import get_law
+    from colonsim.limits import (POINTS_RANGE, check_count, check_geometry_mm, check_mesh, check_seed,
+                                 check_workers)
     from colonsim.identification.pipeline import Budget
     from colonsim.identification.population import calibrate_curve, calibrate_specimens, population_summary, population_table, write_population
     from colonsim.identification.report import write_calibration
@@ -175,10 +177,16 @@ def calibrate(request: CalibrationRequest, out: Path) -> list:
         raise ColonsimError("--compare-laws fits one curve (or the mean curve); drop --per-specimen")
     law = request.law or "mooney_rivlin_3"
     get_law(law)
-    if request.points < 5:
+    if isinstance(request.points, int) and request.points < POINTS_RANGE[0]:
         raise ColonsimError(f"--points {request.points} is too few to fit 3 parameters; use at least 5 (default 20)")
-    if request.workers < 1:
-        raise ColonsimError(f"--workers {request.workers}; give at least 1")
+    check_count("--points", request.points, *POINTS_RANGE)
+    check_workers("--workers", request.workers)
+    check_seed("--seed", request.seed)
+    check_mesh("--mesh", request.mesh)
+    for quantity in ("length", "width", "thickness"):
+        value = getattr(request, f"{quantity}_mm")
+        if value is not None:
+            check_geometry_mm(quantity, value, request.given_as)
     curves = _load_curves(request)
     budget = Budget.quick() if request.quick else Budget()
     options = dict(law=law, analytic=request.analytic, budget=budget, seed=request.seed, n_points=request.points)

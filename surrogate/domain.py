@@ -110,7 +110,7 @@ class SegmentDomain:
             if name in INPUT_RANGES and values is not None:
                 for i, value in enumerate(self.numbers(values, name)):
                     if not np.isnan(value):
-                        check_input_range(name, value, f"segment {self.segment}: query {i + 1} has ")
+                        check_input_range(name, value, f"segment {self.segment}: query {i + 1}: ")
 
     def unknown_inputs(self, query: dict) -> list:
         """Candidate inputs the query sets but the model has neither as an input nor as a fixed

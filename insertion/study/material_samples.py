@@ -189,8 +189,8 @@ def _draws(section, base, seed, max_runs) -> tuple[Path, list]:
     if samples is not None and (isinstance(samples, bool) or not isinstance(samples, int) or samples < 1):
         raise ColonsimError(f"[material] samples = {samples!r}; give the number of materials to draw, e.g. samples = 20")
     if samples is not None and samples > max_runs:  # before any draw is allocated
-        raise ColonsimError(f"[material] samples = {samples:,} is more than the {max_runs:,} runs a sweep may hold; "
-                            "lower samples")
+        raise ColonsimError(f"[material] samples = {samples:,}: more than the {max_runs:,} a sweep may hold (checked before "
+                            "drawing); lower samples")
     if "file" in section:
         if samples is None:
             raise ColonsimError("[material] file = ... needs samples = N, the number of materials drawn from its posterior")

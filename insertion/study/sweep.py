@@ -34,7 +34,9 @@ import pandas as pd
 
 from colonsim.errors import ColonsimError
 from colonsim.files import atomic_path, check_output_folder, output_set, write_json
+from colonsim.limits import SCHEDULER_CHECK_S
 from colonsim.provenance import code_version
+from colonsim.scheduler_address import check_scheduler
 from colonsim.insertion.case.run_budget import DEFAULT_MAX_STEPS, check_sweep_budget
 from colonsim.insertion.case.scenario import InsertionResult
 from colonsim.insertion.study.sweep_rows import IDENTITY, OUTPUTS, input_columns, input_row, result_row
@@ -241,12 +243,13 @@ def dask_outcomes(cases, address, runner=None, log=print):
     once, at its first run (outside the timed part), which also covers workers that join late.
     """
     Client = dask_distributed().Client
-
+    check_scheduler(address)  # an unroutable address or another server fails here, in seconds and one line
     try:  # connect now, so an unreachable scheduler fails before anything is written
-        client = Client(address, timeout="15s", set_as_default=False)
-    except (OSError, TimeoutError) as exc:
-        raise ColonsimError(f"cannot reach the Dask scheduler at {address} ({exc}); start one with "
-                            f"`dask scheduler` and workers with `dask worker {address} --nthreads 1`") from None
+        client = Client(address, timeout=f"{SCHEDULER_CHECK_S:g}s", set_as_default=False)
+    except Exception as exc:  # OSError, TimeoutError, a handshake distributed could not read, ...
+        raise ColonsimError(f"cannot reach the Dask scheduler at {address} ({type(exc).__name__}: "
+                            f"{' '.join(str(exc).split())[:200]}); start one with `dask scheduler` and workers with "
+                            f"`dask worker {address} --nthreads 1`") from None
     return _dask_stream(client, cases, address, runner, log)
 
 
