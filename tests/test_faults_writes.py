@@ -14,6 +14,7 @@ import shutil
 import subprocess
 import sys
 import textwrap
+import time
 from pathlib import Path
 
 import pandas as pd
@@ -132,15 +133,20 @@ def test_a_file_where_a_results_folder_goes_is_refused_at_the_swap_without_damag
     no_staging(out)
 
 
-def test_cli_calibrate_into_a_folder_whose_material_json_is_a_folder(tmp_path):
+def test_cli_calibrate_into_a_folder_whose_material_json_is_a_folder(tmp_path, capsys):
+    from colonsim.cli import main
+
     out = tmp_path / "cal"
-    before = earlier_set(out)
+    earlier_set(out)
     (out / "material.json").unlink()
     (out / "material.json").mkdir()
     before = digest(out)
-    proc = run([sys.executable, "-m", "colonsim.cli", "calibrate", "--analytic", "--quick", "--points", "5",
-                "--out", str(out)], timeout=30)
-    one_line_error(proc, "material.json", "a folder stands where the results file goes")
+    t0 = time.monotonic()
+    code = main(["calibrate", "--analytic", "--quick", "--points", "5", "--no-progress", "--out", str(out)])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert code == 2 and len(err) == 1, err
+    assert "material.json: a folder stands where the results file goes" in err[0]
+    assert time.monotonic() - t0 < 5  # refused before the fit
     assert digest(out) == before
 
 
@@ -180,6 +186,50 @@ def test_calibrate_under_a_file_size_limit_keeps_the_earlier_calibration(tmp_pat
                 "--no-progress", "--out", str(out)], preexec=limited(50), timeout=60)
     line = one_line_error(proc, "file-size limit", "ulimit -f unlimited", "earlier results there are unchanged")
     assert STAGING_PREFIX not in line
+    assert digest(out) == before
+    no_staging(out)
+
+
+SCRIPT_INSERT = textwrap.dedent("""
+    import sys
+    import numpy as np
+    import pandas as pd
+    import colonsim.insertion.case.scenario as scenario
+    from colonsim.cli import main
+
+    COLUMNS = ["time_s", "depth_m", "deformation_m", "max_stretch", "tip_displacement_m", "tip_arc_m",
+               "tip_past_end_m", "contact_force_N", "push_force_N", "contact_nodes", "kinetic_colon_J",
+               "internal_colon_J", "kinetic_scope_J", "kinetic_scope_sliding_J", "internal_scope_J",
+               "contact_energy_J", "dt_s", "step"]
+
+    def standin(case, progress=None, snapshot_interval=None):
+        # SYNTHETIC run: no simulation, a result of the recorder's shape whose time series
+        # (about 1 MB of CSV) exceeds the file-size limit the test sets
+        ts = pd.DataFrame({c: np.linspace(0.0, 1.0, 4000) for c in COLUMNS}).assign(phase="push")
+        summary = {"scope": {"name": case.scope.upper(), "diameter_mm": 11.0}, "final_deformation_cm": 1.0,
+                   "max_deformation_cm": 2.0, "points_cm": {}, "peak_contact_force_N": 1.0,
+                   "peak_push_force_N": 2.0, "max_wall_stretch": 1.1,
+                   "quasi_static": {"ringing_ratio": 0.05, "holds": True}, "ended_by": "far_end",
+                   "end": {"reason": "far end", "depth_cm": 20.0}, "steps": 10, "wall_time_s": 0.1}
+        return scenario.InsertionResult(case, ts, summary, snapshots=[], model=None,
+                                        final_shape={"colon_m": np.zeros((4, 3)), "scope_m": np.zeros((2, 3))})
+
+    scenario.run_insertion = standin
+    sys.exit(main(sys.argv[1:]))
+""")
+
+
+def test_insert_under_a_file_size_limit_keeps_the_earlier_run(tmp_path):
+    """The audit's case: ``colonsim insert`` into an earlier run's folder under ``ulimit -f 200``
+    changed its summary.json. The simulation is a stand-in (the writes are what is tested)."""
+    out = tmp_path / "ins"
+    argv = [sys.executable, "-c", SCRIPT_INSERT, "insert", "--segment", "straight", "--scope", "utc",
+            "--no-progress", "--out", str(out)]
+    earlier_set(out / "straight_UTC")
+    (out / "comparison.csv").write_text("earlier\n")
+    before = digest(out)
+    proc = run(argv, preexec=limited(200), timeout=60)
+    one_line_error(proc, "file-size limit", "earlier results there are unchanged")
     assert digest(out) == before
     no_staging(out)
 
