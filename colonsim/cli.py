@@ -142,6 +142,9 @@ def cmd_insert(args):
         from colonsim.insertion.case.results import check_vtu_writer
 
         check_vtu_writer()
+        if not 1e-3 <= args.snapshot_every <= 10.0:  # a snapshot per time step would fill memory and disk
+            raise ColonsimError(f"--snapshot-every {args.snapshot_every:g} s is outside 0.001-10 s; give the "
+                                "simulated seconds between VTU snapshots (default 0.02)")
     if args.threads is not None:
         if not 1 <= args.threads <= numba.config.NUMBA_NUM_THREADS:
             raise ColonsimError(f"--threads {args.threads} must lie in 1-{numba.config.NUMBA_NUM_THREADS} (the cores Numba sees)")

@@ -6,7 +6,8 @@ from pathlib import Path
 
 from colonsim.errors import ColonsimError
 from colonsim.files import check_output_folder
-from colonsim.options import finite_float, output_folder, positive_int, worker_count
+from colonsim.limits import MAX_RUNS
+from colonsim.options import bounded_int, finite_float, output_folder, positive_int, worker_count
 from colonsim.insertion.case.run_budget import DEFAULT_MAX_STEPS
 from colonsim.workflows import available_cores
 
@@ -36,7 +37,8 @@ def add_parser(sub):
     a = p.add_argument_group("adaptive sweeps (docs/sweeps.md, 'Adaptive sweeps')")
     a.add_argument("--adaptive", action="store_true",
                    help="choose the runs: the [lhs] hypercube first, then batches where the surrogate is least certain")
-    a.add_argument("--budget", type=positive_int, metavar="N", help="most runs in all (with --adaptive; required)")
+    a.add_argument("--budget", type=bounded_int(1, MAX_RUNS), metavar="N",
+                   help=f"most runs in all, at most {MAX_RUNS:,} (with --adaptive; required)")
     a.add_argument("--target-rmse", type=finite_float, metavar="X",
                    help="stop when the leave-one-out RMSE of --target is at most X in every segment (its unit: cm "
                         "for deformations); default: run to the budget")

@@ -22,6 +22,11 @@ DOCUMENT_MAX_BYTES = 16 * 2**20
 # 20,000 runs (the largest sweep) take a few MB; this leaves room for hand-made tables.
 TABLE_MAX_BYTES = 512 * 2**20
 
+# -- sweeps ------------------------------------------------------------------------------------
+# Runs of one sweep (grid x hypercube x materials) and of an adaptive sweep's budget: ~3 s to
+# expand and validate; 28 hours of computing at the fastest runs measured.
+MAX_RUNS = 20_000
+
 # -- calibration --------------------------------------------------------------------------------
 # FE divisions of the quarter strip (along the length, across the half-width): every objective
 # evaluation solves this mesh at every displacement point, 600 evaluations per fit; 8x3 is the

@@ -55,6 +55,8 @@ CASES = {
                                       "--restarts: 1000 is outside 0-50"),
     "surrogate fit --threads 100000": (["surrogate", "fit", "{ws}/r.parquet", "-o", "{ws}/m", "--threads", "100000"],
                                        "100000 is more than the"),
+    "sweep --adaptive --budget 1e8": (["sweep", "{ws}/huge_lhs.toml", "--adaptive", "--budget", "100000000"],
+                                      "--budget: 100000000 is outside 1-20,000"),
     "insert --friction 3": (["insert", "--segment", "straight", "--friction", "3"], "friction = 3 is outside [0, 2]"),
     "insert --diameter -30": (["insert", "--segment", "straight", "--diameter", "-30"], "diameter_mm = -30 is outside"),
 }
@@ -88,6 +90,17 @@ def test_vtu_without_meshio_fails_before_the_runs(tmp_path, capsys, monkeypatch)
     err = capsys.readouterr().err.strip().splitlines()
     assert code == 2 and len(err) == 1 and "VTU output needs meshio" in err[0], err
     assert time.monotonic() - t0 < 10  # no insertion ran
+    assert not (tmp_path / "o").exists()
+
+
+def test_vtu_snapshots_are_bounded_before_the_runs(tmp_path, capsys, monkeypatch):
+    import types
+
+    monkeypatch.setitem(sys.modules, "meshio", types.ModuleType("meshio"))  # present, never reached
+    code = main(["insert", "--segment", "straight", "--vtu", "--snapshot-every", "1e-300", "--no-progress",
+                 "--out", str(tmp_path / "o")])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert code == 2 and len(err) == 1 and "--snapshot-every 1e-300 s is outside 0.001-10 s" in err[0], err
     assert not (tmp_path / "o").exists()
 
 

@@ -64,6 +64,7 @@ import numpy as np
 from colonsim.catalog import NAMED_SCOPES
 from colonsim.errors import ColonsimError
 from colonsim.inputs import check_input, read_input_text
+from colonsim.limits import MAX_RUNS  # re-exported: the bound the sweep docs name
 from colonsim.insertion.case.scenario import InsertionCase
 from colonsim.insertion.study.material_samples import MATERIAL_PARAMETERS, sample_materials
 from colonsim.insertion.study.sweep_presets import PRESETS  # re-exported: the presets load_sweep knows
@@ -77,7 +78,6 @@ SCOPE_DIAMETER = "scope_diameter_mm"
 SECTIONS = ("sweep", "fixed", "grid", "lhs", "material")
 SWEEP_KEYS = ("name", "seed", "description")
 LHS_DECIMALS = 3
-MAX_RUNS = 20_000  # ~3 s to expand and validate; 28 hours of computing at the fastest runs measured
 # Wall time of one run on one core: the thesis preset on the 2-core development machine (README):
 # RSJ 5-17 s, RSF 45-120 s, THF 50-260 s at the default mesh.
 RUN_SECONDS = (5.0, 260.0)
