@@ -158,7 +158,7 @@ def _kind(path: Path) -> str | None:
     return "folder" if path.is_dir() else "file" if path.exists() else None
 
 
-def _check_entries(folder: Path, entries: dict):
+def check_entries(folder: Path, entries: dict):
     """Refuse (before any work or swap) an entry of ``folder`` whose kind differs from what the
     set puts there: a folder where a results file goes, or the reverse."""
     for name, kind in entries.items():
@@ -172,7 +172,7 @@ def _swap_in(stage: Path, folder: Path):
     """Move every entry of ``stage`` into ``folder``: a file replaces its namesake in one step, a
     folder replaces its namesake as a whole (the old one is moved into ``stage`` and removed with it)."""
     entries = {p.name: "folder" if p.is_dir() else "file" for p in stage.iterdir()}
-    _check_entries(folder, entries)
+    check_entries(folder, entries)
     retired = Path(tempfile.mkdtemp(prefix=".retired-", dir=stage))
     for name, kind in sorted(entries.items(), key=lambda e: e[1] == "file"):  # folders first, files last
         target = folder / name
@@ -205,7 +205,7 @@ def output_set(folder, files=(), folders=()):
     try:
         if created:
             folder.mkdir(parents=True)
-        _check_entries(folder, {**{n: "file" for n in files}, **{n: "folder" for n in folders}})
+        check_entries(folder, {**{n: "file" for n in files}, **{n: "folder" for n in folders}})
         stage = Path(tempfile.mkdtemp(prefix=STAGING_PREFIX, dir=folder))
         os.chmod(stage, 0o777 & ~_umask())
         yield stage

@@ -321,3 +321,20 @@ def test_calibrate_on_a_full_or_read_only_disk(tmp_path, mode, words):
     assert same == "True"
     assert names == "['fit.csv', 'history.csv', 'material.json']"  # no staging folder left
     assert not any(disk.iterdir())  # the tmpfs lived in the child's namespace only
+
+
+@pytest.mark.parametrize("entry,kind", [(TABLE, "folder"), ("runs", "file")])
+def test_a_sweep_whose_table_is_a_folder_is_refused_before_any_run(tmp_path, entry, kind, capsys):
+    from colonsim.cli import main
+
+    out = tmp_path / "sweep"
+    out.mkdir()
+    (out / entry).mkdir() if kind == "folder" else (out / entry).write_text("a user's file\n")
+    before = digest(out)
+    t0 = time.monotonic()
+    code = main(["sweep", "--preset", "smoke", "--workers", "1", "--no-progress", "--out", str(out)])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert code == 2 and len(err) == 1, err
+    assert f"{entry}: a {kind} stands where the results" in err[0], err[0]
+    assert time.monotonic() - t0 < 10  # no run started
+    assert digest(out) == before and sorted(p.name for p in out.iterdir()) == [entry]

@@ -33,7 +33,7 @@ from pathlib import Path
 import pandas as pd
 
 from colonsim.errors import ColonsimError
-from colonsim.files import atomic_path, check_output_folder, output_set, write_json
+from colonsim.files import atomic_path, check_entries, check_output_folder, output_set, write_json
 from colonsim.limits import SCHEDULER_CHECK_S
 from colonsim.provenance import code_version
 from colonsim.scheduler_address import check_scheduler
@@ -339,6 +339,7 @@ def run_sweep(cases, out, workers=2, scheduler=None, runner=None, retry_failed=F
     if scheduler:
         dask_distributed()  # a missing dask fails before anything is written
     out = check_output_folder(out)
+    check_entries(out, {TABLE: "file", SWEEP_DOCUMENT: "file", "runs": "folder"})  # before any run, not after
     check_sweep_budget(cases, max_steps)
     t0 = time.perf_counter()
     with SweepStore(out) as store:
