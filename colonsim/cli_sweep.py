@@ -85,7 +85,21 @@ def _adaptive(args, spec, settings, out, workers, where):
     print(f"results: {out / 'results.parquet'}; rounds: {out / ROUNDS}; figure: {out / FIGURE}")
 
 
+def _dask_installed() -> bool:
+    import importlib.util
+
+    try:
+        return importlib.util.find_spec("distributed") is not None
+    except (ImportError, ValueError):  # a module set to None (blocked) or half imported
+        return False
+
+
 def cmd_sweep(args):
+    if args.scheduler is not None and not args.dry_run and _dask_installed():
+        from colonsim.scheduler_address import check_scheduler
+
+        # first, before the heavy imports: an address where no scheduler answers fails within seconds
+        check_scheduler(args.scheduler)
     from colonsim.insertion.case.run_budget import check_sweep_budget
     from colonsim.insertion.study.adaptive_sweep import ROUNDS
     from colonsim.insertion.study.sweep import SweepStore, dask_distributed, describe_cases, run_sweep
@@ -94,10 +108,7 @@ def cmd_sweep(args):
     if args.scheduler is not None and args.workers is not None:
         raise ColonsimError("--workers is for local runs; a Dask cluster (--scheduler) has its own workers")
     if args.scheduler is not None and not args.dry_run:
-        from colonsim.scheduler_address import check_scheduler
-
-        dask_distributed()  # a missing dask fails before the sweep is announced or anything written
-        check_scheduler(args.scheduler)  # so does an address where no scheduler answers (within seconds)
+        dask_distributed()  # so does a missing dask, before the sweep is announced or anything written
     workers = available_cores() if args.workers is None else args.workers
     settings = _adaptive_settings(args, workers)
     spec = load_sweep(args.spec, args.preset)
