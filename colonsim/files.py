@@ -151,7 +151,6 @@ def atomic_paths(*paths):
                 os.unlink(tmp)
 
 
-
 def _kind(path: Path) -> str | None:
     if path.is_symlink():
         return "link"
