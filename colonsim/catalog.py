@@ -1,4 +1,4 @@
-"""The catalog: colon models, named scopes and results-table columns, each defined once.
+"""The catalog: colon models, named scopes, results-table columns and input ranges, each defined once.
 
 The solver side (:mod:`colonsim.insertion.anatomy.colon_segments`,
 :mod:`colonsim.insertion.anatomy.scopes`, :mod:`colonsim.insertion.case.scenario`), the sweep,
