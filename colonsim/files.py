@@ -106,13 +106,14 @@ def write_failure(exc: OSError, target, unchanged=True) -> ColonsimError:
     (``unchanged``: say that the earlier files there were left as they were)."""
     cause, fix = _WRITE_FAILURES.get(exc.errno, (exc.strerror or type(exc).__name__, "choose another --out"))
     kept = "; earlier results there are unchanged" if unchanged else ""
-    return ColonsimError(f"cannot write {_final(target)}: {cause}; {fix}{kept}")
+    shown = target if isinstance(target, str) else _final(target)
+    return ColonsimError(f"cannot write {shown}: {cause}; {fix}{kept}")
 
 
 def os_failure(exc: OSError) -> ColonsimError:
     """One line for an OSError that reached the command line: the cause, the file, what to do."""
     if exc.errno in _WRITE_FAILURES:
-        return write_failure(exc, exc.filename or "a result file", unchanged=False)
+        return write_failure(exc, _final(exc.filename) if exc.filename else "a result file", unchanged=False)
     where = f" ({_final(exc.filename)})" if exc.filename else ""
     return ColonsimError(f"{exc.strerror or type(exc).__name__}{where}; check the file, the disk and the options")
 
@@ -144,7 +145,7 @@ def atomic_paths(*paths):
         for tmp, path in zip(temps, paths):
             os.replace(tmp, path)
     except OSError as exc:
-        raise write_failure(exc, paths[0] if len(paths) == 1 else paths[0].parent) from None
+        raise write_failure(exc, " and ".join(str(_final(p)) for p in paths)) from None
     finally:
         for tmp in temps:
             if os.path.exists(tmp):

@@ -338,3 +338,19 @@ def test_a_sweep_whose_table_is_a_folder_is_refused_before_any_run(tmp_path, ent
     assert f"{entry}: a {kind} stands where the results" in err[0], err[0]
     assert time.monotonic() - t0 < 10  # no run started
     assert digest(out) == before and sorted(p.name for p in out.iterdir()) == [entry]
+
+
+def test_surrogate_fit_under_a_file_size_limit_keeps_the_earlier_model(tmp_path):
+    """A model is a pair (JSON + arrays): both replaced together or neither."""
+    from colonsim.cli import main
+    from colonsim.surrogate.synthetic import synthetic_sweep
+
+    synthetic_sweep(design="grid", noise_cm=0.02, seed=1).to_parquet(tmp_path / "results.parquet")
+    argv = ["surrogate", "fit", str(tmp_path / "results.parquet"), "-o", str(tmp_path / "model"), "--restarts", "0",
+            "--targets", "final_deformation_cm"]
+    assert main(argv) == 0
+    before = digest(tmp_path)
+    assert (tmp_path / "model.npz").stat().st_size > 8 * 1024  # so the limit below bites
+    proc = run([sys.executable, "-m", "colonsim.cli", *argv, "--seed", "7"], preexec=limited(8), timeout=60)
+    one_line_error(proc, "model.npz", "file-size limit", "earlier results there are unchanged")
+    assert digest(tmp_path) == before
