@@ -354,3 +354,20 @@ def test_surrogate_fit_under_a_file_size_limit_keeps_the_earlier_model(tmp_path)
     proc = run([sys.executable, "-m", "colonsim.cli", *argv, "--seed", "7"], preexec=limited(8), timeout=60)
     one_line_error(proc, "model.npz", "file-size limit", "earlier results there are unchanged")
     assert digest(tmp_path) == before
+
+
+def test_an_oserror_no_writer_caught_is_still_one_line(monkeypatch, capsys):
+    """The command line's last resort: an OSError from anywhere is one line (exit 2), the staging
+    folder's name hidden, the cause and the fix named."""
+    import errno
+
+    from colonsim import cli
+
+    def failing(args):
+        raise OSError(errno.ENOSPC, "No space left on device", f"/data/out/{STAGING_PREFIX}abc/fit.csv")
+
+    monkeypatch.setattr(cli, "cmd_calibrate", failing)
+    assert cli.main(["calibrate"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert err == ["colonsim: error: cannot write /data/out/fit.csv: the disk is full; free some space or choose "
+                   "--out on another disk"]
