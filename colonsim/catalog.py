@@ -1,4 +1,5 @@
-"""The catalog: colon models, named scopes and results-table columns, each defined once.
+"""The catalog: colon models, named scopes and results-table columns, each defined once (the
+input ranges every command shares: :mod:`colonsim.input_ranges`).
 
 The solver side (:mod:`colonsim.insertion.anatomy.colon_segments`,
 :mod:`colonsim.insertion.anatomy.scopes`, :mod:`colonsim.insertion.case.scenario`), the sweep,

@@ -13,7 +13,10 @@ from pathlib import Path
 
 from colonsim import catalog, cli_material, cli_surrogate, cli_sweep
 from colonsim.errors import ColonsimError, ColonsimWarning
-from colonsim.options import finite_float, output_folder, positive_int
+from colonsim.files import os_failure
+from colonsim.input_ranges import check_input_range
+from colonsim.limits import MESH_MAX, POINTS_RANGE
+from colonsim.options import bounded_int, finite_float, output_folder, positive_int, seed, worker_count
 from colonsim.insertion.case.run_budget import DEFAULT_MAX_STEPS
 
 
@@ -25,6 +28,9 @@ def _mesh(text):
             raise ValueError
     except ValueError:
         raise argparse.ArgumentTypeError(f"mesh must look like 8x3 (divisions along the length x half-width), got {text!r}")
+    if nl > MESH_MAX[0] or nw > MESH_MAX[1]:
+        raise argparse.ArgumentTypeError(f"{nl}x{nw} is finer than {MESH_MAX[0]}x{MESH_MAX[1]} (every objective "
+                                         "evaluation solves this mesh; 8x3 is the default)")
     return nl, nw
 
 
@@ -40,9 +46,9 @@ def _add_calibrate(sub):
     src.add_argument("--curve", type=Path,
                      help="one force-displacement CSV or testing-machine export (geometry from --length, --width, "
                           "--thickness or the file's preamble)")
-    src.add_argument("--length", type=float, help="free length between the grips, mm (wins over the file's preamble)")
-    src.add_argument("--width", type=float, help="specimen width, mm (wins over the file's preamble)")
-    src.add_argument("--thickness", type=float, help="wall thickness, mm (wins over the file's preamble)")
+    src.add_argument("--length", type=finite_float, help="free length between the grips, mm (wins over the file's preamble)")
+    src.add_argument("--width", type=finite_float, help="specimen width, mm (wins over the file's preamble)")
+    src.add_argument("--thickness", type=finite_float, help="wall thickness, mm (wins over the file's preamble)")
     src.add_argument("--displacement-unit", help="unit of the displacement column if the header does not say (mm, m, cm, um, in)")
     src.add_argument("--force-unit", help="unit of the force column if the header does not say (N, mN, kN, gf, kgf, lbf)")
     fit = p.add_argument_group("fit")
@@ -56,11 +62,12 @@ def _add_calibrate(sub):
     fit.add_argument("--analytic", action="store_true",
                      help="fit the closed-form homogeneous uniaxial model instead of the clamped FE strip")
     fit.add_argument("--mesh", type=_mesh, default=(8, 3), help="FE divisions of the quarter strip, default 8x3")
-    fit.add_argument("--points", type=int, default=20, help="simulation displacement points (default 20)")
+    fit.add_argument("--points", type=bounded_int(*POINTS_RANGE), default=20,
+                     help=f"simulation displacement points, {POINTS_RANGE[0]}-{POINTS_RANGE[1]} (default 20)")
     fit.add_argument("--quick", action="store_true",
                      help="reduced budget (40 designs, 100 CMA-ES, 160 Nelder-Mead evaluations) instead of 100/300/300")
-    fit.add_argument("--seed", type=int, default=1, help="seed of the Latin hypercube and CMA-ES (default 1)")
-    fit.add_argument("--workers", type=int, default=2, help="processes for --per-specimen (default 2)")
+    fit.add_argument("--seed", type=seed, default=1, help="seed of the Latin hypercube and CMA-ES (default 1)")
+    fit.add_argument("--workers", type=worker_count, default=2, help="processes for --per-specimen (default 2)")
     cli_material.add_calibrate_options(p)
     p.add_argument("--out", type=output_folder, default="colonsim_results/calibration",
                    help="output folder (default colonsim_results/calibration)")
@@ -87,6 +94,8 @@ def cmd_calibrate(args):
 
 def cmd_demo(args):
     from colonsim.demo import DemoOptions, run_demo
+
+    check_input_range("element_size_mm", args.element_size, "--element-size: ")  # before the calibration runs
 
     run_demo(DemoOptions(out=args.out, element_size_mm=args.element_size, workers=args.workers,
                          show_progress=not args.no_progress, target=args.target))
@@ -140,6 +149,13 @@ def cmd_insert(args):
 
     from colonsim.insertion.case.scenario import InsertionCase
 
+    if args.vtu:  # fails before the runs, not after them
+        from colonsim.insertion.case.results import check_vtu_writer
+
+        check_vtu_writer()
+        if not 1e-3 <= args.snapshot_every <= 10.0:  # a snapshot per time step would fill memory and disk
+            raise ColonsimError(f"--snapshot-every {args.snapshot_every:g} s is outside 0.001-10 s; give the "
+                                "simulated seconds between VTU snapshots (default 0.02)")
     if args.threads is not None:
         if not 1 <= args.threads <= numba.config.NUMBA_NUM_THREADS:
             raise ColonsimError(f"--threads {args.threads} must lie in 1-{numba.config.NUMBA_NUM_THREADS} (the cores Numba sees)")
@@ -155,9 +171,10 @@ def cmd_insert(args):
                            exit_length_mm=args.exit_length, distal_resistance_N=args.distal_resistance)
              for scope in args.scope]
     if args.material is not None:
+        from colonsim.inputs import check_input
         from colonsim.insertion.engine.material import load_material
 
-        load_material(args.material)
+        load_material(check_input(args.material, "material file"))
     from colonsim.workflows import insert
 
     insert(cases, args.out, vtu=args.vtu, snapshot_every=args.snapshot_every, show=not args.no_progress,
@@ -186,7 +203,7 @@ def build_parser():
     demo.add_argument("--out", type=output_folder, default="colonsim_demo", help="output folder (default colonsim_demo)")
     demo.add_argument("--element-size", type=finite_float, default=3.0,
                       help="wall mesh of the insertions and the sweep, mm (default 3; coarser is faster, not validated)")
-    demo.add_argument("--workers", type=positive_int, default=None,
+    demo.add_argument("--workers", type=worker_count, default=None,
                       help="processes for the demo's sweep (default: up to 2 cores)")
     demo.add_argument("--no-progress", action="store_true", help="no progress bar")
     demo.add_argument("--target", choices=("max_deformation_cm", "final_deformation_cm"), default=catalog.PAIN_PROXY,
@@ -221,6 +238,9 @@ def main(argv=None):
         except KeyboardInterrupt:
             print("colonsim: interrupted; files written so far are complete", file=sys.stderr)
             return 130
+        except OSError as exc:  # a failure no writer or reader turned into its own line
+            print(f"colonsim: error: {_one_line(os_failure(exc))}", file=sys.stderr)
+            return 2
     return 0
 
 

@@ -13,7 +13,7 @@ from pathlib import Path
 
 from colonsim import catalog
 from colonsim.errors import ColonsimError
-from colonsim.options import finite_float, output_file
+from colonsim.options import bounded_int, finite_float, output_file, seed, worker_count
 
 # command-line option -> results-table column
 RAW_OPTIONS = {"scope_diameter": "scope_diameter_mm", "diameter": "diameter_mm", "angle": "angle_deg",
@@ -73,15 +73,15 @@ def add_parsers(sub):
     fit.add_argument("--targets", nargs="+", help="output columns to model (default: deformations, A, C, forces, stretch)")
     fit.add_argument("--segments", nargs="+", help="segments to fit (default: all in the table)")
     fit.add_argument("--cv", type=_cv, default="loo", help="'loo' (closed-form leave-one-out, default) or k folds")
-    fit.add_argument("--restarts", type=int, default=2, help="extra optimizer starts per GP (default 2)")
-    fit.add_argument("--min-runs", type=int, default=4, help="fewest runs a model is fitted on (default 4)")
-    fit.add_argument("--seed", type=int, default=0, help="seed of the restarts and folds (default 0)")
+    fit.add_argument("--restarts", type=bounded_int(0, 50), default=2, help="extra optimizer starts per GP, 0-50 (default 2)")
+    fit.add_argument("--min-runs", type=bounded_int(2, 20_000), default=4, help="fewest runs a model is fitted on (default 4)")
+    fit.add_argument("--seed", type=seed, default=0, help="seed of the restarts and folds (default 0)")
     fit.add_argument("--material", type=Path, help=MATERIAL_HELP.replace("predictions average", "stored with the "
                                                                           "model, that predictions average"))
     fit.add_argument("--replicates", type=Path,
                      help="results table of training cases run again at another mesh or push speed: their scatter "
                           "is each output's noise floor (docs/surrogate.md, 'Noise floor')")
-    fit.add_argument("--threads", type=int, default=1,
+    fit.add_argument("--threads", type=worker_count, default=1,
                      help="BLAS threads (default 1; more only pays on an idle machine with thousands of runs)")
     fit.set_defaults(func=cmd_fit)
 
@@ -249,18 +249,20 @@ def _patient_query(model, segment, args, presets):
 
 def _query_frame(args, model):
     """One row per query: from --csv (options fill its missing columns) or from the options, one per scope."""
+    import io
+
     import numpy as np
     import pandas as pd
 
+    from colonsim.inputs import read_input_text
     from colonsim.surrogate.patients import patient_inputs
     from colonsim.surrogate.recommend import default_scopes
 
     presets = _presets(args)
     if args.csv:
-        if not args.csv.is_file():
-            raise ColonsimError(f"query file {args.csv} not found")
+        text = read_input_text(args.csv, "query file")
         try:
-            frame = pd.read_csv(args.csv)
+            frame = pd.read_csv(io.StringIO(text))
         except (pd.errors.ParserError, pd.errors.EmptyDataError, UnicodeDecodeError) as exc:
             raise ColonsimError(f"cannot read {args.csv}: {str(exc).splitlines()[0]}") from None
         if args.segment:

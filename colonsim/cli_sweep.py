@@ -6,7 +6,8 @@ from pathlib import Path
 
 from colonsim.errors import ColonsimError
 from colonsim.files import check_output_folder
-from colonsim.options import finite_float, output_folder, positive_int
+from colonsim.limits import MAX_RUNS
+from colonsim.options import bounded_int, finite_float, output_folder, positive_int, worker_count
 from colonsim.insertion.case.run_budget import DEFAULT_MAX_STEPS
 from colonsim.workflows import available_cores
 
@@ -22,7 +23,7 @@ def add_parser(sub):
     p.add_argument("--preset", help="thesis (the source's 39 insertions), validation (the validation report's "
                                     "24 extra runs), resistance (the distal resistance study, 136 runs) or smoke "
                                     "(3 fast runs)")
-    p.add_argument("--workers", type=positive_int, default=None,
+    p.add_argument("--workers", type=worker_count, default=None,
                    help=f"local worker processes, one Numba thread each (default: the cores, {available_cores()} here)")
     p.add_argument("--scheduler", metavar="ADDR",
                    help="run on a Dask distributed cluster, e.g. tcp://HOST:8786 (workers: dask worker ADDR --nthreads 1)")
@@ -37,7 +38,8 @@ def add_parser(sub):
     a = p.add_argument_group("adaptive sweeps (docs/sweeps.md, 'Adaptive sweeps')")
     a.add_argument("--adaptive", action="store_true",
                    help="choose the runs: the [lhs] hypercube first, then batches where the surrogate is least certain")
-    a.add_argument("--budget", type=positive_int, metavar="N", help="most runs in all (with --adaptive; required)")
+    a.add_argument("--budget", type=bounded_int(1, MAX_RUNS), metavar="N",
+                   help=f"most runs in all, at most {MAX_RUNS:,} (with --adaptive; required)")
     a.add_argument("--target-rmse", type=finite_float, metavar="X",
                    help="stop when the leave-one-out RMSE of --target is at most X in every segment (its unit: cm "
                         "for deformations); default: run to the budget")
@@ -84,7 +86,21 @@ def _adaptive(args, spec, settings, out, workers, where):
     print(f"results: {out / 'results.parquet'}; rounds: {out / ROUNDS}; figure: {out / FIGURE}")
 
 
+def _dask_installed() -> bool:
+    import importlib.util
+
+    try:
+        return importlib.util.find_spec("distributed") is not None
+    except (ImportError, ValueError):  # a module set to None (blocked) or half imported
+        return False
+
+
 def cmd_sweep(args):
+    if args.scheduler is not None and not args.dry_run and _dask_installed():
+        from colonsim.scheduler_address import check_scheduler
+
+        # first, before the heavy imports: an address where no scheduler answers fails within seconds
+        check_scheduler(args.scheduler)
     from colonsim.insertion.case.run_budget import check_sweep_budget
     from colonsim.insertion.study.adaptive_sweep import ROUNDS
     from colonsim.insertion.study.sweep import SweepStore, dask_distributed, describe_cases, run_sweep
@@ -93,7 +109,7 @@ def cmd_sweep(args):
     if args.scheduler is not None and args.workers is not None:
         raise ColonsimError("--workers is for local runs; a Dask cluster (--scheduler) has its own workers")
     if args.scheduler is not None and not args.dry_run:
-        dask_distributed()  # a missing dask fails before the sweep is announced or anything written
+        dask_distributed()  # so does a missing dask, before the sweep is announced or anything written
     workers = available_cores() if args.workers is None else args.workers
     settings = _adaptive_settings(args, workers)
     spec = load_sweep(args.spec, args.preset)

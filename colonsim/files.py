@@ -4,16 +4,38 @@ A command checks its output folder or file with :func:`check_output_folder` /
 :func:`check_output_file` before it starts, so a bad ``--out`` costs nothing and leaves nothing.
 Writers replace files only once their new content is complete (:func:`atomic_paths`), and files
 that belong together (a model's JSON and arrays) are replaced together, after all are written.
+A command that writes a set of files and folders writes them into a staging folder and swaps
+them in only when every one is complete (:func:`output_set`): a full disk, a file-size limit or
+a read-only folder leaves the earlier set byte-identical. A write that fails says why in one
+line (:func:`write_failure`).
 """
 
 from __future__ import annotations
 
+import errno
 import json
 import math
 import os
+import shutil
 import tempfile
 from contextlib import contextmanager
 from pathlib import Path
+
+STAGING_PREFIX = ".colonsim-staging-"
+
+# errno -> (what happened, what to do); the causes a user can meet and act on
+_WRITE_FAILURES = {
+    errno.ENOSPC: ("the disk is full", "free some space or choose --out on another disk"),
+    errno.EDQUOT: ("the disk quota is used up", "free some space or choose --out on another disk"),
+    errno.EFBIG: ("a file reached the file-size limit (ulimit -f)", "raise the limit (ulimit -f unlimited)"),
+    errno.EROFS: ("the file system is read-only", "choose --out on a writable disk"),
+    errno.EACCES: ("permission denied", "choose a folder you may write to"),
+    errno.EPERM: ("operation not permitted", "choose a folder you may write to"),
+    errno.EISDIR: ("a folder stands where a file goes", "move that folder away or choose another --out"),
+    errno.ENOTDIR: ("a file stands where a folder goes", "move that file away or choose another --out"),
+    errno.ENOTEMPTY: ("a folder stands where a file goes", "move that folder away or choose another --out"),
+    errno.EIO: ("the disk reported an input/output error", "check the disk and choose another --out"),
+}
 
 from colonsim.errors import ColonsimError
 
@@ -79,11 +101,35 @@ def check_output_file(path, option="-o", suffixes=None) -> Path:
     return path
 
 
+def write_failure(exc: OSError, target, unchanged=True) -> ColonsimError:
+    """One line for a write to ``target`` that failed with ``exc``: the cause and what to do
+    (``unchanged``: say that the earlier files there were left as they were)."""
+    cause, fix = _WRITE_FAILURES.get(exc.errno, (exc.strerror or type(exc).__name__, "choose another --out"))
+    kept = "; earlier results there are unchanged" if unchanged else ""
+    shown = target if isinstance(target, str) else _final(target)
+    return ColonsimError(f"cannot write {shown}: {cause}; {fix}{kept}")
+
+
+def os_failure(exc: OSError) -> ColonsimError:
+    """One line for an OSError that reached the command line: the cause, the file, what to do."""
+    if exc.errno in _WRITE_FAILURES:
+        return write_failure(exc, _final(exc.filename) if exc.filename else "a result file", unchanged=False)
+    where = f" ({_final(exc.filename)})" if exc.filename else ""
+    return ColonsimError(f"{exc.strerror or type(exc).__name__}{where}; check the file, the disk and the options")
+
+
+def _final(path) -> Path:
+    """Where a file being written into a staging folder (:func:`output_set`) will end up."""
+    path = Path(path)
+    return Path(*[p for p in path.parts if not p.startswith(STAGING_PREFIX)])
+
+
 @contextmanager
 def atomic_paths(*paths):
     """Yield a temporary path beside each of ``paths``; when the block succeeds they replace
     ``paths`` (in the order given), when it fails every temporary file is removed and nothing
-    is replaced."""
+    is replaced. A failed write (disk full, read-only, ...) becomes a one-line
+    :class:`ColonsimError` (:func:`write_failure`)."""
     paths = [Path(p) for p in paths]
     temps = []
     try:
@@ -98,10 +144,79 @@ def atomic_paths(*paths):
             os.chmod(tmp, mode)
         for tmp, path in zip(temps, paths):
             os.replace(tmp, path)
+    except OSError as exc:
+        raise write_failure(exc, " and ".join(str(_final(p)) for p in paths)) from None
     finally:
         for tmp in temps:
             if os.path.exists(tmp):
                 os.unlink(tmp)
+
+
+def _kind(path: Path) -> str | None:
+    if path.is_symlink():
+        return "link"
+    return "folder" if path.is_dir() else "file" if path.exists() else None
+
+
+def check_entries(folder: Path, entries: dict):
+    """Refuse (before any work or swap) an entry of ``folder`` whose kind differs from what the
+    set puts there: a folder where a results file goes, or the reverse."""
+    for name, kind in entries.items():
+        found = _kind(folder / name)
+        if found is not None and found != kind:
+            raise ColonsimError(f"cannot write {folder / name}: a {found} stands where the results {kind} goes; "
+                                f"move it away or choose another --out")
+
+
+def _swap_in(stage: Path, folder: Path):
+    """Move every entry of ``stage`` into ``folder``: a file replaces its namesake in one step, a
+    folder replaces its namesake as a whole (the old one is moved into ``stage`` and removed with it)."""
+    entries = {p.name: "folder" if p.is_dir() else "file" for p in stage.iterdir()}
+    check_entries(folder, entries)
+    retired = Path(tempfile.mkdtemp(prefix=".retired-", dir=stage))
+    for name, kind in sorted(entries.items(), key=lambda e: e[1] == "file"):  # folders first, files last
+        target = folder / name
+        if kind == "folder" and target.is_dir():
+            os.rename(target, retired / name)
+            try:
+                os.rename(stage / name, target)
+            except OSError:
+                os.rename(retired / name, target)
+                raise
+        else:
+            os.replace(stage / name, target)
+
+
+@contextmanager
+def output_set(folder, files=(), folders=()):
+    """Yield a staging folder for the files of one command's results in ``folder``.
+
+    The staging folder lies inside ``folder`` (so on the same disk, where a rename is one step)
+    under a hidden name. When the block succeeds, each of its entries replaces its namesake in
+    ``folder``: a file in one step, a folder as a whole. When the block fails (a full disk, a
+    file-size limit, an error in the work itself), the staging folder is removed and ``folder``
+    keeps its earlier files byte-identical; an OSError becomes one line (:func:`write_failure`).
+    ``files`` and ``folders`` name the entries the set will hold, checked before the block runs
+    (a folder standing where a results file goes is refused before any work).
+    """
+    folder = Path(folder)
+    created = not folder.exists()
+    stage = None
+    try:
+        if created:
+            folder.mkdir(parents=True)
+        check_entries(folder, {**{n: "file" for n in files}, **{n: "folder" for n in folders}})
+        stage = Path(tempfile.mkdtemp(prefix=STAGING_PREFIX, dir=folder))
+        os.chmod(stage, 0o777 & ~_umask())
+        yield stage
+        _swap_in(stage, folder)
+    except OSError as exc:
+        raise write_failure(exc, folder) from None
+    finally:
+        if stage is not None:
+            shutil.rmtree(stage, ignore_errors=True)
+        if created and folder.is_dir() and not any(folder.iterdir()):
+            folder.rmdir()
 
 
 @contextmanager

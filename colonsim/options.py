@@ -12,6 +12,7 @@ import math
 
 from colonsim.errors import ColonsimError
 from colonsim.files import check_output_file, check_output_folder
+from colonsim.limits import SEED_RANGE, WORKERS_PER_CORE, max_workers
 
 
 def finite_float(text) -> float:
@@ -34,6 +35,39 @@ def positive_int(text) -> int:
     if value < 1:
         raise argparse.ArgumentTypeError(f"{value} must be at least 1")
     return value
+
+
+def bounded_int(low, high):
+    """A type for a whole number in [``low``, ``high``] (the bounds of :mod:`colonsim.limits`)."""
+    def int_type(text):
+        value = positive_int(text) if low >= 1 else _whole(text)
+        if not low <= value <= high:
+            raise argparse.ArgumentTypeError(f"{value} is outside {low:,}-{high:,}")
+        return value
+
+    int_type.__name__ = "whole number"
+    return int_type
+
+
+def _whole(text) -> int:
+    try:
+        return int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a whole number") from None
+
+
+def worker_count(text) -> int:
+    """Local worker processes: 1 to :func:`colonsim.limits.max_workers` (a few per core)."""
+    value = positive_int(text)
+    if value > max_workers():
+        raise argparse.ArgumentTypeError(f"{value} is more than the {max_workers()} processes this machine can use "
+                                         f"({WORKERS_PER_CORE} per core)")
+    return value
+
+
+def seed(text) -> int:
+    """A random seed, 0 to 2**32 - 1."""
+    return bounded_int(*SEED_RANGE)(text)
 
 
 def _checked(check, text, *args):

@@ -181,8 +181,10 @@ def _print_warnings(results):
 
 def calibrate(request: CalibrationRequest, out: Path) -> list:
     """Load the curves ``request`` names, calibrate, write results into ``out``; return the results."""
-    from colonsim.files import check_output_folder
+    from colonsim.files import check_output_folder, output_set
     from colonsim.laws import get_law
+    from colonsim.limits import (POINTS_RANGE, check_count, check_geometry_mm, check_mesh, check_seed,
+                                 check_workers)
     from colonsim.identification.pipeline import Budget
     from colonsim.identification.population import calibrate_curve, calibrate_specimens, population_summary, population_table, write_population
     from colonsim.identification.report import write_calibration
@@ -195,10 +197,16 @@ def calibrate(request: CalibrationRequest, out: Path) -> list:
         raise ColonsimError("--compare-laws fits one curve (or the mean curve); drop --per-specimen")
     law = request.law or "mooney_rivlin_3"
     get_law(law)
-    if request.points < 5:
+    if isinstance(request.points, int) and request.points < POINTS_RANGE[0]:
         raise ColonsimError(f"--points {request.points} is too few to fit 3 parameters; use at least 5 (default 20)")
-    if request.workers < 1:
-        raise ColonsimError(f"--workers {request.workers}; give at least 1")
+    check_count("--points", request.points, *POINTS_RANGE)
+    check_workers("--workers", request.workers)
+    check_seed("--seed", request.seed)
+    check_mesh("--mesh", request.mesh)
+    for quantity in ("length", "width", "thickness"):
+        value = getattr(request, f"{quantity}_mm")
+        if value is not None:
+            check_geometry_mm(quantity, value, request.given_as)
     curves = _clean(_load_curves(request), request, out)
     budget = Budget.quick() if request.quick else Budget()
     options = dict(law=law, analytic=request.analytic, budget=budget, seed=request.seed, n_points=request.points)
@@ -216,7 +224,8 @@ def calibrate(request: CalibrationRequest, out: Path) -> list:
             results = calibrate_specimens(curves, workers=workers, progress=bar.evaluation, **options)
         finally:
             bar.close()
-        paths = write_population(results, out)
+        with output_set(out) as stage:  # replaced as a whole, after every file is written
+            write_population(results, stage)
         for r in results:
             print(_format_result(r))
         _print_warnings(results)
@@ -237,10 +246,11 @@ def calibrate(request: CalibrationRequest, out: Path) -> list:
         result = calibrate_curve(curve, progress=lambda stage, n, e1: bar.evaluation(curve.name, stage, n, e1), **options)
     finally:
         bar.close()
-    paths = write_calibration(result, out)
+    with output_set(out, files=("material.json",)) as stage:
+        write_calibration(result, stage)
     print(_format_result(result))
     _print_warnings([result])
-    print(f"results: {paths['material']} (+ history.csv, sensitivity.csv, top10_designs.csv, fit.csv, *.png in {out}/)")
+    print(f"results: {out / 'material.json'} (+ history.csv, sensitivity.csv, top10_designs.csv, fit.csv, *.png in {out}/)")
     return [result]
 
 
@@ -248,6 +258,7 @@ def _compare_laws(curve, options, per_eval, show, out: Path) -> list:
     """``calibrate --compare-laws``: every law of :data:`colonsim.laws.LAWS` on ``curve``, BIC chooses."""
     import pandas as pd
 
+    from colonsim.files import output_set
     from colonsim.identification.law_comparison import compare_laws, write_law_comparison
     from colonsim.identification.population import calibrate_curve
     from colonsim.laws import LAWS
@@ -262,14 +273,15 @@ def _compare_laws(curve, options, per_eval, show, out: Path) -> list:
         comparison = compare_laws(fit)
     finally:
         bar.close()
-    paths = write_law_comparison(comparison, out)
+    with output_set(out, files=("material.json", "laws.csv", "laws.png"), folders=("laws",)) as stage:
+        write_law_comparison(comparison, stage)
     shown = comparison.table.drop(columns=["note"]).set_index("law")
     with pd.option_context("display.width", 200, "display.max_columns", 30):
         print(shown.to_string(float_format=lambda v: f"{v:.4g}", na_rep="-"))
     print(f"chosen: {comparison.chosen}, {comparison.reason}")
     print(_format_result(comparison.chosen_result))
     _print_warnings([comparison.chosen_result])
-    print(f"results: {paths['material']} ({comparison.chosen}), {paths['laws_table']}, {paths['laws_plot']}; "
+    print(f"results: {out / 'material.json'} ({comparison.chosen}), {out / 'laws.csv'}, {out / 'laws.png'}; "
           f"every law's calibration files in {out}/laws/")
     return [comparison.chosen_result]
 
@@ -306,15 +318,25 @@ def insert(cases, out: Path, vtu=False, snapshot_every=0.02, show=True, max_step
 
     Every case is checked first, its run time estimated included (:mod:`colonsim.insertion.case.run_budget`):
     a case needing more than ``max_steps`` time steps is refused before any run starts."""
+    from colonsim.files import output_set
+    from colonsim.insertion.case.run_budget import check_run_budget
+
+    budgets = [check_run_budget(case, max_steps) for case in cases]
+    with output_set(out, files=("comparison.csv", "comparison.png")) as stage:  # swapped in when all are written
+        results = _run_cases(cases, budgets, out, stage, vtu, snapshot_every, show)
+    print(f"comparison: {out}/comparison.csv, {out}/comparison.png")
+    return results
+
+
+def _run_cases(cases, budgets, out, stage, vtu, snapshot_every, show):
+    """Run ``cases`` and write their folders and the comparison into ``stage`` (what becomes ``out``)."""
     from tqdm import tqdm
 
     from colonsim.files import save_figure, write_csv
     from colonsim.insertion.case.results import (comparison_table, distal_words, insertion_figure, quasi_static_words,
                                               write_insertion)
-    from colonsim.insertion.case.run_budget import check_run_budget
     from colonsim.insertion.case.scenario import run_insertion
 
-    budgets = [check_run_budget(case, max_steps) for case in cases]
     results = []
     for case, budget in zip(cases, budgets):
         print(f"{case.segment.upper()} {case.scope.upper()}: {budget.describe()}", flush=True)
@@ -331,8 +353,9 @@ def insert(cases, out: Path, vtu=False, snapshot_every=0.02, show=True, max_step
             r = run_insertion(case, progress=progress, snapshot_interval=snapshot_every if vtu else None)
         finally:
             bar.close()
-        folder = out / f"{case.segment}_{r.summary['scope']['name'].replace(' ', '')}"
-        write_insertion(r, folder, vtu=vtu)
+        name = f"{case.segment}_{r.summary['scope']['name'].replace(' ', '')}"
+        write_insertion(r, stage / name, vtu=vtu)
+        folder = out / name
         results.append(r)
         s = r.summary
         pts = ", ".join(f"{k} {v['deformation_cm']:.2f} cm" for k, v in s["points_cm"].items() if v is not None)
@@ -342,7 +365,6 @@ def insert(cases, out: Path, vtu=False, snapshot_every=0.02, show=True, max_step
               f"ended: {s['end']['reason']} at {s['end']['depth_cm']:.1f} cm; "
               f"{s['steps']} steps in {s['wall_time_s']:.1f} s -> {folder}/")
     table, figure = comparison_table(results), insertion_figure(results)  # both made before either file is replaced
-    write_csv(out / "comparison.csv", table)
-    save_figure(figure, out / "comparison.png")
-    print(f"comparison: {out}/comparison.csv, {out}/comparison.png")
+    write_csv(stage / "comparison.csv", table)
+    save_figure(figure, stage / "comparison.png")
     return results

@@ -28,6 +28,8 @@ import re
 from dataclasses import dataclass, field
 
 from colonsim.errors import ColonsimError
+from colonsim.inputs import read_input
+from colonsim.limits import TEXT_FILE_MAX_BYTES
 
 DELIMITERS = ("\t", ";", ",")
 _DISPLACEMENT_WORDS = ("disp", "extension", "elongation", "position", "crosshead", "stroke", "travel", "traverse",
@@ -192,11 +194,7 @@ def _decimal_mark(rows, columns):
 
 def read_text(path) -> tuple[str, str]:
     """Text and encoding of the file at ``path`` (see :func:`decode`)."""
-    try:
-        raw = path.read_bytes()
-    except OSError as exc:
-        raise ColonsimError(f"{path}: cannot read the file ({exc.strerror}); check its permissions") from None
-    return decode(raw, path)
+    return decode(read_input(path, "test file", TEXT_FILE_MAX_BYTES), path)
 
 
 def read_export(path) -> ExportTable:

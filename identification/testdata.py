@@ -24,6 +24,8 @@ from pathlib import Path
 import numpy as np
 
 from colonsim.errors import ColonsimError
+from colonsim.inputs import check_input
+from colonsim.limits import TEXT_FILE_MAX_BYTES
 from colonsim.identification.export_geometry import stated_geometry
 from colonsim.identification.export_layout import parse_column_name, read_export, read_text, unit_text
 
@@ -108,11 +110,7 @@ def check_tension(name, force):
 
 def check_input_file(path, what):
     """``path`` must be an existing regular file: say which of missing/folder it is."""
-    path = Path(path)
-    if path.is_dir():
-        raise ColonsimError(f"{path}: is a folder, not a {what}; give the file itself")
-    if not path.is_file():
-        raise ColonsimError(f"{path}: {what} not found; check the path")
+    check_input(path, what, TEXT_FILE_MAX_BYTES)
 
 
 def _unit_factor(unit, table, quantity, path):
@@ -243,6 +241,16 @@ def read_manifest(path, displacement_unit=None, force_unit=None):
     rows = [{k.strip(): (v or "").strip() for k, v in r.items() if isinstance(k, str)} for r in reader]
     if not rows:
         raise ColonsimError(f"{path}: manifest lists no specimens")
+    seen = set()
+    for r in rows:  # a specimen's name is its results folder (--per-specimen)
+        name = r["specimen"]
+        if not name or name in (".", "..") or any(c in name for c in "/\\"):
+            raise ColonsimError(f"{path}: specimen name {name!r} cannot name a results folder; give a name without "
+                                "slashes")
+        if name in seen:
+            raise ColonsimError(f"{path}: specimen {name!r} is listed twice (its results would overwrite each other); "
+                                "give every row its own name")
+        seen.add(name)
     curves = []
     for r in rows:
         geometry = {}

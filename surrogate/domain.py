@@ -13,6 +13,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from colonsim.input_ranges import INPUT_RANGES, check_input_range
 from colonsim.errors import ColonsimError, ColonsimWarning
 from colonsim.surrogate.table import INPUT_OPTIONS, INPUTS
 
@@ -102,6 +103,15 @@ class SegmentDomain:
             raise ColonsimError(f"segment {self.segment}: query {i + 1} has {name} = {raw[i]!r}; give a finite number")
         return out
 
+    def check_ranges(self, query: dict):
+        """Refuse a query value no insertion accepts (a negative diameter, friction above 2, ...):
+        the ranges of :data:`colonsim.input_ranges.INPUT_RANGES`, which ``colonsim insert`` applies too."""
+        for name, values in query.items():
+            if name in INPUT_RANGES and values is not None:
+                for i, value in enumerate(self.numbers(values, name)):
+                    if not np.isnan(value):
+                        check_input_range(name, value, f"segment {self.segment}: query {i + 1}: ")
+
     def unknown_inputs(self, query: dict) -> list:
         """Candidate inputs the query sets but the model has neither as an input nor as a fixed
         value (the results table had no such column): the model cannot answer for them."""
@@ -114,6 +124,7 @@ class SegmentDomain:
         Returns (X, inside, reasons): the (n, d) inputs, a boolean array and, per row, a text naming
         the offending inputs ("" inside). Raises :class:`ColonsimError` with ``strict``; otherwise warns once
         (:class:`OutOfDomainWarning`) when ``warn``."""
+        self.check_ranges(query)
         unknown = self.unknown_inputs(query)
         if unknown:
             options = ", ".join(INPUT_OPTIONS.get(u, u) for u in unknown)

@@ -24,6 +24,7 @@ from pathlib import Path
 
 from colonsim.catalog import COLON_MODELS
 from colonsim.errors import ColonsimError
+from colonsim.inputs import read_input_text
 
 
 @dataclass(frozen=True)
@@ -38,11 +39,12 @@ class PatientPresets:
     def from_json(cls, path):
         """Presets with the entries of a JSON file (same keys as the attributes) replacing the defaults."""
         try:
-            doc = json.loads(Path(path).read_text(encoding="utf-8"))
-        except FileNotFoundError:
-            raise ColonsimError(f"presets file {path} not found") from None
+            doc = json.loads(read_input_text(path, "presets file"))
         except json.JSONDecodeError as exc:
             raise ColonsimError(f"presets file {path} is not valid JSON ({exc})") from None
+        if not isinstance(doc, dict):
+            raise ColonsimError(f"presets file {path} must hold a JSON object (keys sex_angle_deg, age_friction, "
+                                "region_diameter_mm)")
         unknown = sorted(set(doc) - {"sex_angle_deg", "age_friction", "region_diameter_mm"})
         if unknown:
             raise ColonsimError(f"presets file {path}: unknown key(s) {', '.join(unknown)}; use sex_angle_deg, "

@@ -13,6 +13,7 @@ from __future__ import annotations
 import datetime
 import hashlib
 import json
+import zipfile
 from pathlib import Path
 
 import numpy as np
@@ -21,12 +22,16 @@ from colonsim import __version__
 from colonsim.provenance import code_version
 from colonsim.errors import ColonsimError
 from colonsim.files import atomic_paths, json_text
+from colonsim.inputs import check_input, read_input_text
+from colonsim.limits import TABLE_MAX_BYTES
 from colonsim.surrogate.domain import SegmentDomain
 from colonsim.surrogate.gp import GaussianProcess
 from colonsim.surrogate.model import SweepSurrogate
+from colonsim.surrogate.store_checks import IDENTITY, arrays_path, check_domain, check_entry
 from colonsim.surrogate.tissue import TissueDistribution
 
 FORMAT = "colonsim-surrogate"
+# 1.2: the noise floor and scatter of replicate runs; the arrays say which segment and output they belong to
 FORMAT_VERSION = "1.2"
 ARRAYS = ("X_train", "y_train", "alpha", "L")
 
@@ -55,6 +60,7 @@ def save_surrogate(model: SweepSurrogate, path, source=None):
         for target, gp in model.models_[seg].items():
             for name in ARRAYS:
                 arrays[_key(seg, target, name)] = getattr(gp, name + "_")
+            arrays[_key(seg, target, IDENTITY)] = np.array([seg, target])
             entries[target] = {
                 "kernel": gp.kernel_description,
                 "constant": gp.constant_, "noise_level": gp.noise_level_,
@@ -77,7 +83,7 @@ def save_surrogate(model: SweepSurrogate, path, source=None):
                          "threads": model.threads},
            "training": model.training_, "notes": model.notes_, "segments": segments,
            "tissue": None if model.tissue_ is None else model.tissue_.to_dict()}
-    bad = next((k for k, a in arrays.items() if not np.isfinite(a).all()), None)
+    bad = next((k for k, a in arrays.items() if a.dtype.kind == "f" and not np.isfinite(a).all()), None)
     if bad is not None:
         raise ColonsimError(f"cannot save the surrogate: array {bad} is not finite; nothing was written")
     # Both files are complete and checked before either replaces an earlier model: a failure
@@ -94,11 +100,11 @@ def save_surrogate(model: SweepSurrogate, path, source=None):
 def load_surrogate(path) -> SweepSurrogate:
     """Read a surrogate written by :func:`save_surrogate` (no pickle, no refit)."""
     json_path, npz_path = model_paths(path)
-    if not json_path.is_file():
+    if not json_path.exists():
         raise ColonsimError(f"surrogate file {json_path} not found; write one with 'colonsim surrogate fit RESULTS -o MODEL'")
     try:
-        doc = json.loads(json_path.read_text(encoding="utf-8"))
-    except (json.JSONDecodeError, UnicodeDecodeError) as exc:
+        doc = json.loads(read_input_text(json_path, "surrogate file"))
+    except json.JSONDecodeError as exc:
         raise ColonsimError(f"{json_path} is not valid JSON ({exc}); refit the surrogate") from None
     if not isinstance(doc, dict) or doc.get("format") != FORMAT:
         raise ColonsimError(f"{json_path} is not a colonsim surrogate (no 'format': '{FORMAT}')")
@@ -106,16 +112,18 @@ def load_surrogate(path) -> SweepSurrogate:
         raise ColonsimError(f"{json_path} has surrogate format {doc.get('format_version')}, this colonsim reads "
                             f"{FORMAT_VERSION}; refit it with this version")
     try:
-        npz_path = json_path.with_name(doc["arrays"]["file"])
+        name = doc["arrays"]["file"]
     except (KeyError, TypeError):
         raise ColonsimError(f"{json_path} names no arrays file; refit the surrogate") from None
+    npz_path = arrays_path(json_path, name)
     return _read_pair(doc, json_path, npz_path)
 
 
 def _read_pair(doc, json_path, npz_path) -> SweepSurrogate:
     """The model of a JSON document ``doc`` (read from ``json_path``) and its arrays file."""
-    if not npz_path.is_file():
+    if not npz_path.exists():
         raise ColonsimError(f"arrays file {npz_path} of {json_path} is missing; keep the .json and .npz together")
+    check_input(npz_path, "arrays file", TABLE_MAX_BYTES)
     if _sha256(npz_path) != doc["arrays"].get("sha256"):
         raise ColonsimError(f"{npz_path} does not belong to {json_path} (checksum differs); copy both files of one fit")
     try:
@@ -129,10 +137,12 @@ def _read_pair(doc, json_path, npz_path) -> SweepSurrogate:
         with np.load(npz_path, allow_pickle=False) as arrays:
             for seg, entry in doc["segments"].items():
                 domain = SegmentDomain.from_dict(entry["domain"])
+                check_domain(domain, json_path)
                 model.domains_[seg] = domain
                 model.models_[seg], model.cv_[seg], model.skipped_[seg] = {}, {}, dict(entry["skipped"])
                 model.scatter_[seg] = {}
                 for target, m in entry["models"].items():
+                    check_entry(seg, target, m, domain, arrays, lambda name: _key(seg, target, name), json_path)
                     # files of format 1.0 and 1.1 hold no floor nor scatter
                     gp = GaussianProcess(input_range=(domain.low, domain.high),
                                          noise_floor_sd=float(m.get("noise_floor_sd", 0.0)))
@@ -146,7 +156,9 @@ def _read_pair(doc, json_path, npz_path) -> SweepSurrogate:
                     model.models_[seg][target] = gp
                     model.cv_[seg][target] = m["cross_validation"]
                     model.scatter_[seg][target] = m.get("scatter")
-    except (KeyError, TypeError, ValueError, AttributeError, OSError) as exc:
+    except ColonsimError:
+        raise
+    except (KeyError, TypeError, ValueError, AttributeError, OSError, EOFError, zipfile.BadZipFile) as exc:
         raise ColonsimError(f"{json_path} or its arrays file is damaged ({type(exc).__name__}: {exc}); "
                             "refit the surrogate") from None
     return model

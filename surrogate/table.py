@@ -15,6 +15,8 @@ import pandas as pd
 
 from colonsim import catalog
 from colonsim.errors import ColonsimError
+from colonsim.inputs import check_input
+from colonsim.limits import TABLE_MAX_BYTES
 
 # Derived from the catalog's columns (colonsim.catalog.COLUMNS), for the modules that import them.
 SEGMENTS = catalog.segment_names()
@@ -37,9 +39,7 @@ CENTERLINE = "centerline"  # a patient model's centerline file (colonsim.catalog
 
 def read_results(path) -> pd.DataFrame:
     """Read a sweep results table (Parquet or CSV) and check the columns the surrogate needs."""
-    path = Path(path)
-    if not path.is_file():
-        raise ColonsimError(f"results table {path} not found; give the results.parquet (or .csv) a sweep wrote")
+    path = check_input(path, "results table", TABLE_MAX_BYTES)
     try:
         frame = pd.read_csv(path) if path.suffix.lower() == ".csv" else pd.read_parquet(path)
     except Exception as exc:  # pyarrow and pandas raise many types for a damaged file

@@ -28,6 +28,7 @@ import pandas as pd
 
 from colonsim.catalog import WALL_C11, WALL_MU0
 from colonsim.errors import ColonsimError
+from colonsim.inputs import check_input
 from colonsim.surrogate.domain import OutOfDomainWarning
 from colonsim.insertion.engine.material import read_material_document
 from colonsim.insertion.study.material_samples import (MATERIAL_PARAMETERS, Posterior, read_population,
@@ -58,7 +59,7 @@ class TissueDistribution:
     @classmethod
     def from_file(cls, path):
         """A calibration's ``material.json`` (its posterior) or a ``population.json`` (its specimens)."""
-        path = Path(path)
+        path = check_input(path, "material file")
         if "specimens" in read_material_document(path):
             pop = read_population(path)
             return cls("empirical", str(path), f"the {len(pop.values)} specimens of {path.name} ({pop.law})",

@@ -26,6 +26,8 @@ LAYERS = {
     "colonsim": GROUND,
     "colonsim.errors": GROUND, "colonsim.files": GROUND, "colonsim.provenance": GROUND,
     "colonsim.markdown": GROUND, "colonsim.data": GROUND, "colonsim.catalog": GROUND, "colonsim.laws": GROUND,
+    "colonsim.inputs": GROUND, "colonsim.limits": GROUND, "colonsim.scheduler_address": GROUND,
+    "colonsim.input_ranges": GROUND,
     "colonsim.insertion": PHYSICS,
     "colonsim.insertion.engine": PHYSICS,
     "colonsim.insertion.anatomy": ANATOMY,

@@ -112,6 +112,7 @@ def test_a_surrogate_fitted_over_the_resistance_needs_it_in_every_query():
     assert "distal_resistance_N" in model.domains_["rsf"].inputs
     query = {"scope": "pdc", "angle_deg": 30.0, "friction": 0.05}
     with pytest.raises(ColonsimError, match="give distal_resistance_N .*--distal-resistance on the command line"):
-        model.predict(query, "rsf")
-    low, high = (model.predict({**query, "distal_resistance_N": r}, "rsf")[0] for r in (0.0, 20.0))
+        model.predict(query, "rsf", "final_deformation_cm")
+    low, high = (model.predict({**query, "distal_resistance_N": r}, "rsf", "final_deformation_cm")[0]
+                 for r in (0.0, 20.0))
     assert high > low + 0.5  # it learned the resistance's effect

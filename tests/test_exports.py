@@ -172,7 +172,7 @@ def test_a_tensile_curve_pulls(force, message):
 def test_geometry_errors_quote_mm_and_folders_are_not_missing_files(tmp_path):
     with pytest.raises(ColonsimError, match="thickness must be a positive number of mm, got -1 mm"):
         read_curve(EXPORTS / "mts_testsuite_kN.csv", length=0.1, width=0.025, thickness=-1e-3)
-    with pytest.raises(ColonsimError, match="is a folder, not a test data file"):
+    with pytest.raises(ColonsimError, match="is a folder, not a file"):
         read_curve(tmp_path, **GEOM)
-    with pytest.raises(ColonsimError, match="is a folder, not a manifest"):
+    with pytest.raises(ColonsimError, match="is a folder, not a file"):
         read_manifest(tmp_path)

@@ -98,8 +98,9 @@ def test_save_load_round_trip_without_pickle(model, tmp_path):
         "rmse", "max_abs_error", "coverage_95"}
     with zipfile.ZipFile(npz_path) as z:
         assert all(name.endswith(".npy") for name in z.namelist())
-    with np.load(npz_path, allow_pickle=False) as arrays:  # no object arrays inside
-        assert all(arrays[k].dtype == float for k in arrays.files)
+    with np.load(npz_path, allow_pickle=False) as arrays:  # no object arrays inside: numbers, and the identity text
+        assert all(arrays[k].dtype == float for k in arrays.files if not k.endswith("__belongs_to"))
+        assert arrays["rsj__max_deformation_cm__belongs_to"].tolist() == ["rsj", "max_deformation_cm"]
     loaded = load_surrogate(json_path)
     rng = np.random.default_rng(2)
     q = {"scope_diameter_mm": rng.uniform(8, 14, 50), "diameter_mm": rng.uniform(20, 40, 50),

@@ -38,11 +38,14 @@ from pathlib import Path
 import numpy as np
 
 from colonsim.errors import ColonsimError
+from colonsim.inputs import check_input, read_input_text
+from colonsim.limits import TEXT_FILE_MAX_BYTES
 
 MIN_POINTS = 5  # scipy's cubic smoothing spline needs 5 points
 DUPLICATE_MM = 1e-3  # consecutive points closer than 1 um repeat a point (chord-length parameter 0)
 DIAMETER_RANGE_MM = (5.0, 120.0)  # a lumen narrower than 5 mm holds no scope; 120 mm is beyond any colon
 COORDINATE_LIMIT_MM = 1e4  # 10 m: a larger coordinate is a unit slip (um or nm written as mm)
+MIN_EXTENT_MM = 20.0  # points spanning less are no colon: a centerline in metres (0.2 for 20 cm) written as mm
 COORDINATES = ("x_mm", "y_mm", "z_mm")
 OPTIONAL = ("diameter_mm", "name")
 LABELS = ("fixed", "mobile")
@@ -102,14 +105,7 @@ def _number(text, column, path, line):
 
 def _rows(path: Path):
     """(line number, cells) of the header and each data row."""
-    try:
-        text = path.read_text(encoding="utf-8-sig")
-    except FileNotFoundError:
-        raise ColonsimError(f"centerline file {path} not found; give the path of a centerline CSV") from None
-    except IsADirectoryError:
-        raise ColonsimError(f"centerline file {path} is a folder; give the path of a centerline CSV") from None
-    except (OSError, UnicodeDecodeError) as exc:
-        raise ColonsimError(f"cannot read centerline file {path} ({exc}); give a UTF-8 text CSV") from None
+    text = read_input_text(path, "centerline file", TEXT_FILE_MAX_BYTES, fallbacks=("cp1252",))
     lines = text.splitlines()
     rows = []
     for number, cells in zip(range(1, len(lines) + 1), csv.reader(lines)):
@@ -164,6 +160,10 @@ def read_centerline_points(path) -> CenterlinePoints:
         raise ColonsimError(f"{path}: {len(points)} point(s); a centerline needs at least {MIN_POINTS} "
                             "(a cubic smoothing spline), give more points")
     p = np.array(points)
+    extent = float(np.ptp(p, axis=0).max())
+    if extent < MIN_EXTENT_MM:
+        raise ColonsimError(f"{path}: the points span {extent:.3g} mm, no colon is that small; the _mm columns take "
+                            f"millimetres (coordinates in metres? multiply them by 1000)")
     gaps = np.linalg.norm(np.diff(p, axis=0), axis=1)
     if np.any(gaps < DUPLICATE_MM):
         i = int(np.argmax(gaps < DUPLICATE_MM))
@@ -203,11 +203,6 @@ def _cached(resolved: str, mtime_ns: int, size: int) -> CenterlinePoints:
 
 def load_centerline_points(path) -> CenterlinePoints:
     """:func:`read_centerline_points`, cached per file state (path, modification time, size)."""
-    path = Path(path).expanduser()
-    try:
-        stat = path.stat()
-    except FileNotFoundError:
-        raise ColonsimError(f"centerline file {path} not found; give the path of a centerline CSV") from None
-    except OSError as exc:
-        raise ColonsimError(f"cannot read centerline file {path} ({exc}); give the path of a centerline CSV") from None
+    path = check_input(Path(path).expanduser(), "centerline file", TEXT_FILE_MAX_BYTES)
+    stat = path.stat()
     return _cached(str(path), stat.st_mtime_ns, stat.st_size)

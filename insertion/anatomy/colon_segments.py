@@ -35,6 +35,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from colonsim.catalog import PAST_JUNCTION, PAST_MOBILE_END, colon_model
+from colonsim.input_ranges import INPUT_RANGES
 from colonsim.errors import ColonsimError
 from colonsim.insertion.anatomy.centerline import Straight
 from colonsim.insertion.anatomy.colon_centerlines import (EXIT_LENGTH, FLEXURE_ANGLE_DEG, rsf_centerline, rsj_centerline,
@@ -42,7 +43,7 @@ from colonsim.insertion.anatomy.colon_centerlines import (EXIT_LENGTH, FLEXURE_A
 from colonsim.insertion.anatomy.colon_geometry import tube_mesh
 from colonsim.insertion.engine.sheet_mesh import straight_tube
 
-EXIT_LIMIT = 0.4  # m, fixed exit piece (RSF takes about 31 cm for its available length)
+EXIT_LIMIT = 1e-3 * INPUT_RANGES["exit_length_mm"][1]  # m, fixed exit piece (RSF takes about 31 cm)
 STRAIGHT_LENGTH = 0.20  # m, the straight sanity tube
 
 

@@ -12,9 +12,10 @@ import math
 from dataclasses import asdict, dataclass
 
 from colonsim.catalog import colon_model
+from colonsim.input_ranges import check_input_range
 from colonsim.errors import ColonsimError
 from colonsim.insertion.anatomy.centerline_file import load_centerline_points
-from colonsim.insertion.anatomy.colon_segments import EXIT_LIMIT, check_patient_tube
+from colonsim.insertion.anatomy.colon_segments import check_patient_tube
 from colonsim.insertion.anatomy.patient_centerline import SMOOTHING_MM, load_patient_centerline
 from colonsim.insertion.anatomy.scopes import colonoscope
 from colonsim.insertion.case.case_material import case_material
@@ -134,10 +135,10 @@ class InsertionCase:
         if self.centerline is not None and not model.reads_centerline:
             raise ColonsimError(f"a centerline file is given for segment {self.segment!r}, which has its own shape; "
                                 "use segment 'patient' (--centerline implies it) or drop the centerline")
+        for name in ("diameter_mm", "wall_thickness_mm", "element_size_mm", "exit_length_mm", "flexure_angle_deg",
+                     "friction", "distal_resistance_N"):  # the ranges every command shares
+            check_input_range(name, getattr(self, name))
         checks = [
-            ("diameter_mm", self.diameter_mm, 10.0, 80.0, "colon inner diameter in mm (23 or 36 in the source)"),
-            ("wall_thickness_mm", self.wall_thickness_mm, 0.2, 10.0, "wall thickness in mm (2 assumed)"),
-            ("element_size_mm", self.element_size_mm, 0.5, 20.0, "wall element size in mm (3 by default)"),
             ("scope_spacing_mm", self.scope_spacing_mm, 1.0, 50.0, "scope node spacing in mm (5 by default)"),
             ("push_speed", self.push_speed, 1e-3, 5.0, "push speed in m/s (0.3; 0.6 in the source)"),
             ("colon_damping", self.colon_damping, 0.0, 1e4, "damping in 1/s"),
@@ -151,18 +152,12 @@ class InsertionCase:
             ("time_step_factor", self.time_step_factor, 0.01, 1.0, "a safety factor in (0, 1]"),
             ("ramp_s", self.ramp_s, 0.0, 10.0, "ramp duration in s (0.4)"),
             ("relax_s", self.relax_s, 1e-3, 10.0, "relax duration in s (0.1 by default)"),
-            ("exit_length_mm", self.exit_length_mm, 0.0, 1e3 * EXIT_LIMIT, "fixed exit length in mm (100 by default)"),
-            ("distal_resistance_N", self.distal_resistance_N, 0.0, 100.0,
-             "distal resistance in N (5 by default; 0, 5, 10, 20 are the study's levels)"),
             ("failure_stretch", self.failure_stretch, 1.01, 10.0, "wall stretch at which a run ends (1.6)"),
-            ("flexure_angle_deg", self.flexure_angle_deg, 1.0, 180.0, "flexure turn in degrees (90 by default)"),
             ("sheath_reserve_mm", self.sheath_reserve_mm, 0.0, 200.0, "scope length kept in the sheath, mm (20)"),
         ]
         for name, value, lo, hi, what in checks:
             if not (isinstance(value, (int, float)) and math.isfinite(value) and lo <= value <= hi):
                 raise ColonsimError(f"{name} = {value!r} is outside [{lo:g}, {hi:g}]; give the {what}")
-        if not (math.isfinite(self.friction) and 0.0 <= self.friction <= 2.0):
-            raise ColonsimError(f"friction = {self.friction!r} must lie in [0, 2] (the source used 0, 0.05, 0.1)")
         if self.element_size_mm > self.diameter_mm / 3:
             raise ColonsimError(f"element size {self.element_size_mm} mm is too coarse for a {self.diameter_mm} mm colon; "
                                 "use at most a third of the diameter")

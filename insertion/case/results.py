@@ -118,14 +118,19 @@ def _write_vtu(path, points, cells, cell_type):
         meshio.Mesh(points, [(cell_type, cells)]).write(tmp, file_format="vtu")
 
 
-def write_vtu_series(result, folder):
-    """Deformed colon (triangles) and scope (lines) of every snapshot, with ParaView .pvd indexes."""
+def check_vtu_writer():
+    """Refuse VTU output when meshio is missing (checked before the runs by the command line)."""
     try:
         import meshio  # noqa: F401
     except ImportError:
         from colonsim.errors import ColonsimError
 
         raise ColonsimError("VTU output needs meshio: pip install 'colonsim[io]' (or pip install meshio)") from None
+
+
+def write_vtu_series(result, folder):
+    """Deformed colon (triangles) and scope (lines) of every snapshot, with ParaView .pvd indexes."""
+    check_vtu_writer()
     folder = Path(folder)
     entries = {"colon": [], "scope": []}
     for k, (t, xc, xs) in enumerate(result.snapshots):

@@ -44,6 +44,7 @@ import numpy as np
 
 from colonsim.catalog import WALL_C11, WALL_MU0
 from colonsim.errors import ColonsimError
+from colonsim.inputs import check_input
 from colonsim.laws import get_law
 from colonsim.insertion.case.case_material import case_material
 from colonsim.insertion.engine.material import read_material_document
@@ -168,10 +169,11 @@ def _resolve(value, key, base) -> Path:
     if not isinstance(value, str) or not value.strip():
         raise ColonsimError(f"[material] {key} = {value!r}; give the path of the file colonsim calibrate wrote")
     path = Path(value).expanduser()
-    return (base / path if base is not None and not path.is_absolute() else path).resolve()
+    return check_input((base / path if base is not None and not path.is_absolute() else path).resolve(),
+                       f"[material] {key}")
 
 
-def _draws(section, base, seed) -> tuple[Path, list]:
+def _draws(section, base, seed, max_runs) -> tuple[Path, list]:
     """The file and the parameter dicts a ``[material]`` section asks for."""
     for key in section:
         if key not in SECTION_KEYS:
@@ -186,6 +188,9 @@ def _draws(section, base, seed) -> tuple[Path, list]:
         raise ColonsimError(f"[material] seed = {seed!r}; give a non-negative integer")
     if samples is not None and (isinstance(samples, bool) or not isinstance(samples, int) or samples < 1):
         raise ColonsimError(f"[material] samples = {samples!r}; give the number of materials to draw, e.g. samples = 20")
+    if samples is not None and samples > max_runs:  # before any draw is allocated
+        raise ColonsimError(f"[material] samples = {samples:,}: more than the {max_runs:,} a sweep may hold (checked before "
+                            "drawing); lower samples")
     if "file" in section:
         if samples is None:
             raise ColonsimError("[material] file = ... needs samples = N, the number of materials drawn from its posterior")
@@ -218,7 +223,7 @@ def sample_materials(doc: dict, cases: list, base, seed: int, max_runs: int) -> 
     for where, table in tables:
         if isinstance(table, dict) and "material" in table:
             raise ColonsimError(f"material is set in [{where}] and drawn by [material]; keep one of the two")
-    path, draws = _draws(section, base, seed)
+    path, draws = _draws(section, base, seed, max_runs)
     if len(cases) * len(draws) > max_runs:
         raise ColonsimError(f"[material] makes {len(cases):,} cases x {len(draws):,} materials = "
                             f"{len(cases) * len(draws):,} runs, more than the {max_runs:,} a sweep may hold; lower "

@@ -33,8 +33,10 @@ from pathlib import Path
 import pandas as pd
 
 from colonsim.errors import ColonsimError
-from colonsim.files import atomic_path, check_output_folder, write_json
+from colonsim.files import atomic_path, check_entries, check_output_folder, output_set, write_json
+from colonsim.limits import SCHEDULER_CHECK_S
 from colonsim.provenance import code_version
+from colonsim.scheduler_address import check_scheduler
 from colonsim.insertion.case.run_budget import DEFAULT_MAX_STEPS, check_sweep_budget
 from colonsim.insertion.case.scenario import InsertionResult
 from colonsim.insertion.study.sweep_rows import IDENTITY, OUTPUTS, input_columns, input_row, result_row
@@ -148,7 +150,8 @@ class SweepStore:
             folder = Path("runs") / case.key()
             result = InsertionResult(case, outcome["timeseries"], outcome["summary"], snapshots=[], model=None,
                                      final_shape=outcome.get("final_shape"))
-            written = write_insertion(result, self.folder / folder)
+            with output_set(self.folder / "runs") as stage:  # the run's folder whole, or its earlier one kept
+                written = write_insertion(result, stage / case.key())
             path = (folder / written["timeseries"].name).as_posix()
         row = result_row(case, outcome, path)
         self.rows[row["key"]] = row
@@ -240,12 +243,13 @@ def dask_outcomes(cases, address, runner=None, log=print):
     once, at its first run (outside the timed part), which also covers workers that join late.
     """
     Client = dask_distributed().Client
-
+    check_scheduler(address)  # an unroutable address or another server fails here, in seconds and one line
     try:  # connect now, so an unreachable scheduler fails before anything is written
-        client = Client(address, timeout="15s", set_as_default=False)
-    except (OSError, TimeoutError) as exc:
-        raise ColonsimError(f"cannot reach the Dask scheduler at {address} ({exc}); start one with "
-                            f"`dask scheduler` and workers with `dask worker {address} --nthreads 1`") from None
+        client = Client(address, timeout=f"{SCHEDULER_CHECK_S:g}s", set_as_default=False)
+    except Exception as exc:  # OSError, TimeoutError, a handshake distributed could not read, ...
+        raise ColonsimError(f"cannot reach the Dask scheduler at {address} ({type(exc).__name__}: "
+                            f"{' '.join(str(exc).split())[:200]}); start one with `dask scheduler` and workers with "
+                            f"`dask worker {address} --nthreads 1`") from None
     return _dask_stream(client, cases, address, runner, log)
 
 
@@ -335,6 +339,7 @@ def run_sweep(cases, out, workers=2, scheduler=None, runner=None, retry_failed=F
     if scheduler:
         dask_distributed()  # a missing dask fails before anything is written
     out = check_output_folder(out)
+    check_entries(out, {TABLE: "file", SWEEP_DOCUMENT: "file", "runs": "folder"})  # before any run, not after
     check_sweep_budget(cases, max_steps)
     t0 = time.perf_counter()
     with SweepStore(out) as store:

@@ -63,6 +63,8 @@ import numpy as np
 
 from colonsim.catalog import NAMED_SCOPES
 from colonsim.errors import ColonsimError
+from colonsim.inputs import check_input, read_input_text
+from colonsim.limits import MAX_RUNS  # re-exported: the bound the sweep docs name
 from colonsim.insertion.case.scenario import InsertionCase
 from colonsim.insertion.study.material_samples import MATERIAL_PARAMETERS, sample_materials
 from colonsim.insertion.study.sweep_presets import PRESETS  # re-exported: the presets load_sweep knows
@@ -76,7 +78,6 @@ SCOPE_DIAMETER = "scope_diameter_mm"
 SECTIONS = ("sweep", "fixed", "grid", "lhs", "material")
 SWEEP_KEYS = ("name", "seed", "description")
 LHS_DECIMALS = 3
-MAX_RUNS = 20_000  # ~3 s to expand and validate; 28 hours of computing at the fastest runs measured
 # Wall time of one run on one core: the thesis preset on the 2-core development machine (README):
 # RSJ 5-17 s, RSF 45-120 s, THF 50-260 s at the default mesh.
 RUN_SECONDS = (5.0, 260.0)
@@ -341,7 +342,7 @@ def _check_materials(cases):
     from colonsim.insertion.engine.material import load_material
 
     for path in sorted({c.material for c in cases if c.material}):
-        load_material(path)
+        load_material(check_input(path, "material file"))
 
 
 def load_sweep(path=None, preset: str | None = None) -> SweepSpec:
@@ -353,6 +354,4 @@ def load_sweep(path=None, preset: str | None = None) -> SweepSpec:
             raise ColonsimError(f"unknown preset {preset!r}; use one of {', '.join(PRESETS)}")
         return parse_sweep(PRESETS[preset], origin=f"preset {preset}")
     path = Path(path)
-    if not path.is_file():
-        raise ColonsimError(f"sweep file {path} not found; give the path of a TOML file or use --preset")
-    return parse_sweep(path.read_text(encoding="utf-8"), base=path.parent, origin=str(path))
+    return parse_sweep(read_input_text(path, "sweep file"), base=path.parent, origin=str(path))

@@ -83,6 +83,11 @@ def exit_with_parent():
 
 def start_worker():
     """Initializer of a local pool process (must not raise: the pool would break)."""
+    import signal
+
+    # Ctrl-C reaches the whole process group: the parent stops the sweep and says so in one line;
+    # a worker leaves at once and quietly (a KeyboardInterrupt would print its own traceback)
+    signal.signal(signal.SIGINT, lambda signum, frame: os._exit(130))
     exit_with_parent()
     try:
         prepare_worker()

@@ -1,0 +1,42 @@
+"""Fault corpus, Ctrl-C: interrupting a local sweep prints one line, no worker's traceback, and
+leaves no process behind (Ctrl-C reaches the whole process group, the workers included)."""
+
+import os
+import signal
+import subprocess
+import sys
+import time
+
+import pytest
+
+pytestmark = pytest.mark.skipif(not hasattr(os, "killpg"), reason="needs process groups")
+
+
+def _group_alive(pgid) -> bool:
+    try:
+        os.killpg(pgid, 0)
+    except ProcessLookupError:
+        return False
+    return True
+
+
+def test_ctrl_c_during_a_sweep_is_one_line_and_leaves_no_process(tmp_path):
+    proc = subprocess.Popen([sys.executable, "-m", "colonsim.cli", "sweep", "--preset", "smoke", "--workers", "2",
+                             "--out", str(tmp_path / "sweep"), "--no-progress"], stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE, text=True, start_new_session=True)
+    try:
+        assert "sweep smoke: 3 runs" in proc.stdout.readline()  # the pool starts right after this line
+        time.sleep(3)  # workers spawned, warming up or running
+        os.killpg(proc.pid, signal.SIGINT)  # what Ctrl-C in a terminal does
+        _, err = proc.communicate(timeout=15)
+        t0 = time.monotonic()
+        while _group_alive(proc.pid) and time.monotonic() - t0 < 10:
+            time.sleep(0.2)
+        assert not _group_alive(proc.pid), "a worker outlived the interrupted sweep"
+    finally:
+        if _group_alive(proc.pid):
+            os.killpg(proc.pid, signal.SIGKILL)
+        proc.wait(10)
+    assert proc.returncode == 130
+    assert "Traceback" not in err and "KeyboardInterrupt" not in err, err
+    assert err.strip().splitlines() == ["colonsim: interrupted; files written so far are complete"]
