@@ -198,8 +198,8 @@ SCRIPT_INSERT = textwrap.dedent("""
     from colonsim.cli import main
 
     COLUMNS = ["time_s", "depth_m", "deformation_m", "max_stretch", "tip_displacement_m", "tip_arc_m",
-               "tip_past_end_m", "contact_force_N", "push_force_N", "contact_nodes", "kinetic_colon_J",
-               "internal_colon_J", "kinetic_scope_J", "kinetic_scope_sliding_J", "internal_scope_J",
+               "tip_past_end_m", "lag_m", "distal_force_N", "contact_force_N", "push_force_N", "contact_nodes",
+               "kinetic_colon_J", "internal_colon_J", "kinetic_scope_J", "kinetic_scope_sliding_J", "internal_scope_J",
                "contact_energy_J", "dt_s", "step"]
 
     def standin(case, progress=None, snapshot_interval=None):
@@ -208,7 +208,8 @@ SCRIPT_INSERT = textwrap.dedent("""
         ts = pd.DataFrame({c: np.linspace(0.0, 1.0, 4000) for c in COLUMNS}).assign(phase="push")
         summary = {"scope": {"name": case.scope.upper(), "diameter_mm": 11.0}, "final_deformation_cm": 1.0,
                    "max_deformation_cm": 2.0, "points_cm": {}, "peak_contact_force_N": 1.0,
-                   "peak_push_force_N": 2.0, "max_wall_stretch": 1.1,
+                   "peak_push_force_N": 2.0, "max_wall_stretch": 1.1, "max_lag_cm": 0.0, "final_lag_cm": 0.0,
+                   "distal_resistance": {"resistance_N": 0.0, "acting": False, "final_force_N": 0.0},
                    "quasi_static": {"ringing_ratio": 0.05, "holds": True}, "ended_by": "far_end",
                    "end": {"reason": "far end", "depth_cm": 20.0}, "steps": 10, "wall_time_s": 0.1}
         return scenario.InsertionResult(case, ts, summary, snapshots=[], model=None,
