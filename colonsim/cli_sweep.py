@@ -45,7 +45,8 @@ def add_parser(sub):
                         "for deformations); default: run to the budget")
     a.add_argument("--batch", type=positive_int, metavar="B",
                    help="runs chosen per round (default: the workers, or 4 on a Dask cluster)")
-    a.add_argument("--target", metavar="COLUMN", help="output that chooses the runs (default final_deformation_cm)")
+    a.add_argument("--target", metavar="COLUMN", help="output that chooses the runs (default max_deformation_cm, the "
+                                                      "pain proxy)")
     a.add_argument("--criterion", choices=("variance", "error"),
                    help="where a round runs: greatest posterior variance (default) or greatest expected squared "
                         "prediction error (the nearest run's leave-one-out error plus the variance)")
@@ -96,6 +97,8 @@ def _dask_installed() -> bool:
 
 
 def cmd_sweep(args):
+    if args.scheduler is not None and args.workers is not None:
+        raise ColonsimError("--workers is for local runs; a Dask cluster (--scheduler) has its own workers")
     if args.scheduler is not None and not args.dry_run and _dask_installed():
         from colonsim.scheduler_address import check_scheduler
 
@@ -106,8 +109,6 @@ def cmd_sweep(args):
     from colonsim.insertion.study.sweep import SweepStore, dask_distributed, describe_cases, run_sweep
     from colonsim.insertion.study.sweep_spec import load_sweep
 
-    if args.scheduler is not None and args.workers is not None:
-        raise ColonsimError("--workers is for local runs; a Dask cluster (--scheduler) has its own workers")
     if args.scheduler is not None and not args.dry_run:
         dask_distributed()  # so does a missing dask, before the sweep is announced or anything written
     workers = available_cores() if args.workers is None else args.workers

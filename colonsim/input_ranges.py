@@ -9,7 +9,7 @@ from colonsim.errors import ColonsimError
 INPUT_RANGES = {
     "diameter_mm": (10.0, 80.0, "colon inner diameter in mm (23 or 36 in the source)"),
     "wall_thickness_mm": (0.2, 10.0, "wall thickness in mm (2 assumed)"),
-    "friction": (0.0, 2.0, "Coulomb friction coefficient (the source used 0, 0.05, 0.1)"),
+    "friction": (0.0, 1.0, "Coulomb friction coefficient (the source used 0, 0.05, 0.1)"),
     "flexure_angle_deg": (1.0, 180.0, "flexure turn in degrees (90 by default)"),
     "exit_length_mm": (0.0, 400.0, "fixed exit length in mm (100 by default)"),
     "distal_resistance_N": (0.0, 100.0, "distal resistance in N (5 by default; 0, 5, 10, 20 are the study's levels)"),

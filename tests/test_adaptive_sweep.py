@@ -269,7 +269,7 @@ def test_the_loop_stops_at_the_budget_resumes_without_repeating_and_records_roun
     with pytest.raises(ColonsimError, match="another sweep"):
         run_sweep(spec(samples=5).cases, out, runner=standin_runner, spec=spec(samples=5), progress=False)
     with pytest.raises(ColonsimError, match="chose its runs by"):
-        run_adaptive_sweep(s, out, AdaptiveSettings(budget=14, target="max_deformation_cm"), progress=False)
+        run_adaptive_sweep(s, out, AdaptiveSettings(budget=14, target="final_deformation_cm"), progress=False)
 
 
 def test_the_loop_stops_at_the_target_in_every_segment(tmp_path):

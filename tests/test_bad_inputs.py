@@ -129,7 +129,7 @@ CASES = [
     (["insert", "--diameter", "5", "--out", "{ws}/good_insert"], "diameter_mm = 5 is outside"),
     (["insert", "--friction", "inf", "--out", "{ws}/good_insert"], "'inf' is not a finite number"),
     (["insert", "--angle", "nan", "--out", "{ws}/good_insert"], "'nan' is not a finite number"),
-    (["insert", "--friction", "-1", "--out", "{ws}/good_insert"], "friction = -1 is outside [0, 2]"),
+    (["insert", "--friction", "-1", "--out", "{ws}/good_insert"], "friction = -1 is outside [0, 1]"),
     (["insert", "--wall-thickness", "abc", "--out", "{ws}/good_insert"], "'abc' is not a number"),
     (["insert", "--material", "{ws}/missing.json", "--out", "{ws}/good_insert"], "not found"),
     (["insert", "--material", "{ws}/not_json.json", "--out", "{ws}/good_insert"], "not valid JSON"),
@@ -174,7 +174,7 @@ CASES = [
     # predict
     (["predict", "{ws}/model", "--segment", "rsj", "--diameter", "30", "--friction", "inf"], "'inf' is not a finite number"),
     (["predict", "{ws}/model", "--segment", "rsj", "--diameter", "30", "--friction", "1e308"],
-     "friction = 1e+308 is outside [0, 2]"),
+     "friction = 1e+308 is outside [0, 1]"),
     (["predict", "{ws}/model", "--csv", "{ws}/q_text.csv"], "query 1 has diameter_mm = 'wide'; give a number"),
     (["predict", "{ws}/model", "--csv", "{ws}/q_inf.csv"], "query 1 has friction = inf; give a finite number"),
     (["predict", "{ws}/model", "--csv", "{ws}/missing.csv"], "not found"),
@@ -194,7 +194,7 @@ CASES = [
     # recommend
     (["recommend", "{ws}/model", "--segment", "rsj", "--diameter", "30", "--friction", "nan"], "'nan' is not a finite number"),
     (["recommend", "{ws}/model", "--segment", "rsj", "--diameter", "30", "--friction", "1e308"],
-     "friction = 1e+308 is outside [0, 2]"),
+     "friction = 1e+308 is outside [0, 1]"),
     (["recommend", "{ws}/model", "--segment", "rsj", "--diameter", "30", "--friction", "0", "-o", "{ws}/good"],
      "good is a folder"),
     (["recommend", "{ws}/model", "--segment", "rsj", "--diameter", "30", "--friction", "0",

@@ -57,7 +57,7 @@ CASES = {
                                        "100000 is more than the"),
     "sweep --adaptive --budget 1e8": (["sweep", "{ws}/huge_lhs.toml", "--adaptive", "--budget", "100000000"],
                                       "--budget: 100000000 is outside 1-20,000"),
-    "insert --friction 3": (["insert", "--segment", "straight", "--friction", "3"], "friction = 3 is outside [0, 2]"),
+    "insert --friction 3": (["insert", "--segment", "straight", "--friction", "3"], "friction = 3 is outside [0, 1]"),
     "insert --diameter -30": (["insert", "--segment", "straight", "--diameter", "-30"], "diameter_mm = -30 is outside"),
 }
 

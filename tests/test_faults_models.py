@@ -129,8 +129,8 @@ def test_a_damaged_arrays_file_is_one_line(good, tmp_path, capsys):
 
 @pytest.mark.parametrize("argv,message", [
     (["predict", "{m}", "--segment", "rsj", "--diameter", "-30", "--friction", "0"], "diameter_mm = -30 is outside [10, 80]"),
-    (["predict", "{m}", "--segment", "rsj", "--diameter", "30", "--friction", "-1"], "friction = -1 is outside [0, 2]"),
-    (["recommend", "{m}", "--segment", "rsj", "--diameter", "30", "--friction", "3"], "friction = 3 is outside [0, 2]"),
+    (["predict", "{m}", "--segment", "rsj", "--diameter", "30", "--friction", "-1"], "friction = -1 is outside [0, 1]"),
+    (["recommend", "{m}", "--segment", "rsj", "--diameter", "30", "--friction", "3"], "friction = 3 is outside [0, 1]"),
     (["recommend", "{m}", "--segment", "rsj", "--diameter", "30", "--friction", "0", "--wall-thickness", "-2"],
      "wall_thickness_mm = -2 is outside"),
     (["surrogate", "plot", "{m}", "--segment", "rsj", "--vs", "friction", "--diameter", "-30", "-o", "{d}/p.png"],

@@ -32,6 +32,7 @@ from pathlib import Path
 
 import pandas as pd
 
+from colonsim.catalog import PAIN_PROXY
 from colonsim.errors import ColonsimError
 from colonsim.files import check_output_folder, save_figure, write_json
 from colonsim.insertion.case.run_budget import DEFAULT_MAX_STEPS
@@ -71,7 +72,7 @@ class AdaptiveSettings:
     budget: int
     target_rmse: float | None = None
     batch: int = 4
-    target: str = "final_deformation_cm"
+    target: str = PAIN_PROXY
     criterion: str = "variance"
 
     def check(self, first_round: int):
