@@ -233,8 +233,8 @@ def run_insertion(case: InsertionCase, progress=None, snapshot_interval=None) ->
         held = False
         if model.resistance is not None:  # engaged by where the tip is, along the lumen there (an exit may bend)
             share = resistance_share(model.geometry, last["tip_arc_m"])
-            model.resistance.engage(share, lumen_direction(model.geometry, max(last["tip_arc_m"], model.geometry.exit_start)))
             held = share > 0.0
+            model.resistance.engage(share, lumen_direction(model.geometry, last["tip_arc_m"]) if held else None)
         if ended_by is not None:
             continue
         if last["max_stretch"] > case.failure_stretch:

@@ -88,12 +88,14 @@ class TipResistance:
             raise ColonsimError("tip resistance direction must be a non-zero vector; fix it.")
         return d / norm
 
-    def engage(self, share, direction):
-        """From now on, resist with ``share`` (in [0, 1]) of the resistance along ``direction``."""
+    def engage(self, share, direction=None):
+        """From now on, resist with ``share`` (in [0, 1]) of the resistance, along ``direction``
+        (None: the direction it had)."""
         if not (math.isfinite(share) and 0.0 <= share <= 1.0):
             raise ColonsimError(f"tip resistance engagement {share!r} must lie in [0, 1]; fix it.")
         self.engagement = float(share)
-        self.direction = self._unit(direction)
+        if direction is not None:
+            self.direction = self._unit(direction)
 
     @property
     def engaged_force(self) -> float:
