@@ -356,7 +356,7 @@ COLUMNS = {c.name: c for c in (
     Column("push_speed", _S, "m/s", "plateau push speed"),
     Column("ramp_s", _S, "s", "speed-change ramp"),
     Column("relax_s", _S, "s", "relax pause of straighten-relax-push"),
-    Column("stop_distance_mm", _S, "mm", "push over which the scope slows to rest at the end of the run"),
+    Column("stop_distance_mm", _S, "mm", "push over which the scope slows to rest at the end of the run (0: at once)"),
     Column("settle_s", _S, "s", "time the scope is held still at the end before the final values are read"),
     Column("settle_lateral_damping", _S, "1/s", "lateral damping of the scope while it settles at rest"),
     Column("exit_length_mm", _S, "mm", "fixed colon after the last mobile piece (a minimum where the exit takes the "

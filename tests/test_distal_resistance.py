@@ -8,7 +8,8 @@ import pytest
 
 from colonsim import catalog
 from colonsim.errors import ColonsimError
-from colonsim.insertion.case.scenario import EXIT_MARGIN, InsertionCase, build_insertion, resistance_share
+from colonsim.insertion.case.scenario import (EXIT_MARGIN, InsertionCase, begin_settling, build_insertion,
+                                              resistance_share)
 from colonsim.insertion.engine.constraints import LineConstraint, PrescribedVelocity
 from colonsim.insertion.engine.rod import Rod
 from colonsim.insertion.engine.solver import ExplicitSolver
@@ -53,6 +54,38 @@ def test_zero_resistance_changes_nothing_bit_for_bit():
     held, drive = _pushed_rod([2.0])
     assert not np.array_equal(free.state["scope"].x, held.state["scope"].x)
     assert drive.reaction[0] == pytest.approx(2.0, rel=0.05)  # the push now carries the resistance
+
+
+def _held_after_push(creep_speed_at_rest, waits=6):
+    """A rod pushed against a 2 N tip resistance, its drive then stopped: the resisted force after
+    each 0.05 s of waiting at rest, with the resistance's creep speed at rest as given."""
+    rod = Rod.straight(0.3, 12.8e-3, 16e6, 2944.0, spacing=5e-3, damping_time=3e-3, lateral_damping=200.0)
+    drive = PrescribedVelocity(rod, [0], lambda t: np.array([0.3 if t < 0.05 else 0.0, 0.0, 0.0]), ramp=0.02)
+    sheath = LineConstraint(rod, (0.0, 0.0, 0.0), (1.0, 0.0, 0.0), extent=(-math.inf, 0.1))
+    tip = TipResistance(rod, rod.tip_node, (1.0, 0.0, 0.0), 2.0, creep_speed=3e-3)
+    sim = ExplicitSolver([rod], constraints=[drive, sheath], resistances=[tip])
+    sim.run(0.05, record_interval=1e-3)
+    tip.creep_speed = creep_speed_at_rest
+    forces = []
+    for _ in range(waits):
+        sim.run(0.05, record_interval=1e-3)
+        forces.append(tip.force)
+    return np.array(forces)
+
+
+def test_at_rest_a_creeping_tip_relaxes_its_load_and_a_sticking_one_holds_it():
+    creeping = _held_after_push(3e-3)
+    assert abs(creeping[-1]) < 0.15 * abs(creeping[0])  # the load leaks away for as long as one waits
+    held = _held_after_push(0.0)
+    assert abs(held[0]) > 0.5 and np.allclose(held, held[0], rtol=1e-6)  # static friction: the state of the stop, kept
+
+
+def test_the_settling_run_holds_the_tip_without_creep():
+    model = build_insertion(InsertionCase(segment="rsf", angle_deg=45.0, element_size_mm=COARSE_MM,
+                                          settle_lateral_damping=150.0))
+    assert model.resistance.creep_speed > 0.0
+    begin_settling(model)
+    assert model.resistance.creep_speed == 0.0 and model.rod.lateral_damping == 150.0
 
 
 def test_zero_resistance_builds_no_resistance_and_keeps_the_key_of_before():

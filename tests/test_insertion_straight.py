@@ -32,6 +32,8 @@ def test_the_push_reaches_the_far_end_and_rests(straight_run):
         2 * case.stop_distance_mm * 1e-3 / case.push_speed + case.settle_s, abs=2e-3)
     crossing = ts["depth_m"][ts["tip_past_end_m"] >= 0.0].iloc[0]
     assert ts["depth_m"].iloc[-1] - crossing == pytest.approx(case.stop_distance_mm * 1e-3, abs=1.1e-3)
+    # brought to rest where the push stopped and held: nothing moves at the end
+    assert ts["kinetic_scope_J"].iloc[-1] < 1e-9 and ts["kinetic_colon_J"].iloc[-1] < 1e-9
     # the tip follows the pushed end: a stiff rod in a sheath, no axial buckling
     assert 0.20 + ts["tip_past_end_m"].iloc[-1] == pytest.approx(ts["depth_m"].iloc[-1], abs=0.002)
 

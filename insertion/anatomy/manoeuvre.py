@@ -87,6 +87,14 @@ class PushProfile:
         last = self.phases[-1]
         return last.start if last.name == SETTLE else None
 
+    @property
+    def hold_start(self):
+        """Time the push has come to rest and the closing hold begins, s (None: no settle phase)."""
+        last = self.phases[-1]
+        if last.name != SETTLE:
+            return None
+        return last.start + (self.ramp if last.ramp is None else last.ramp)
+
     def stop(self, t, distance, hold):
         """End the push from time ``t``: slow to rest over ``distance`` (m) of push and hold still
         for ``hold`` seconds (the ``settle`` phase); later phases are dropped."""

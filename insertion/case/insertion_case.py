@@ -77,8 +77,9 @@ class InsertionCase:
     ramp_s, relax_s : float
         Speed-change ramp and the relax pause of RSF/THF, s.
     stop_distance_mm, settle_s : float
-        The push ends at rest: it slows to a stop over ``stop_distance_mm`` of push and the scope
-        is held still for ``settle_s``; the final values are read then.
+        The push ends at rest: it slows to a stop over ``stop_distance_mm`` of push (default 0:
+        at once), every node is then stopped where it is (its kinetic energy removed) and the scope
+        is held still for ``settle_s``; the final values are read then (docs/model.md, "Loading").
     colon_damping, scope_damping : float
         Mass-proportional damping, 1/s (the scope's drags its push: 0 by default).
     scope_lateral_damping : float
@@ -111,7 +112,7 @@ class InsertionCase:
     push_speed: float = 0.3
     ramp_s: float = 0.4
     relax_s: float = 0.1
-    stop_distance_mm: float = 5.0
+    stop_distance_mm: float = 0.0
     settle_s: float = 0.1
     settle_lateral_damping: float = 200.0
     exit_length_mm: float = 100.0
@@ -145,7 +146,7 @@ class InsertionCase:
             ("scope_damping", self.scope_damping, 0.0, 1e4, "damping in 1/s"),
             ("scope_lateral_damping", self.scope_lateral_damping, 0.0, 1e4, "damping in 1/s"),
             ("scope_axial_damping_s", self.scope_axial_damping_s, 0.0, 0.1, "Kelvin-Voigt damping time in s (3e-3)"),
-            ("stop_distance_mm", self.stop_distance_mm, 0.0, 100.0, "push distance to slow to rest, mm (5)"),
+            ("stop_distance_mm", self.stop_distance_mm, 0.0, 100.0, "push distance to slow to rest, mm (0)"),
             ("settle_s", self.settle_s, 0.0, 10.0, "settling time at rest at the end, s (0.1)"),
             ("settle_lateral_damping", self.settle_lateral_damping, 0.0, 1e4, "damping in 1/s"),
             ("record_interval_s", self.record_interval_s, 1e-6, 1.0, "recording interval in s"),

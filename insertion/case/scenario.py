@@ -195,6 +195,27 @@ class InsertionResult:
     final_shape: dict | None = None
 
 
+def begin_settling(model):
+    """The push has stopped: the scope relaxes at rest with its settling lateral damping, and the
+    distal colon holds the tip like static friction, a plain Coulomb resistance without creep
+    (docs/model.md, "Loading"): a creeping tip would go on relaxing the scope for as long as the
+    run waited, so the settled state would depend on the settle time and the push speed."""
+    model.rod.lateral_damping = model.case.settle_lateral_damping
+    if model.resistance is not None:
+        model.resistance.creep_speed = 0.0
+
+
+def bring_to_rest(model):
+    """The push has come to rest: every node of the scope and the wall is stopped where it is, its
+    kinetic energy removed, as dynamic relaxation does (docs/model.md, "Loading"), and the hold
+    that follows finds the equilibrium at the final depth. Left moving, the scope's momentum
+    carries the tip on past the state the push had reached (RSF alpha 45 at 10 N: the tip slid
+    on by 0.9 cm at 0.3 m/s and 0.4 cm at 0.15 m/s), so the settled state would depend on the
+    push speed."""
+    for state in model.solver.state.values():
+        state.v[:] = 0.0
+
+
 CHUNK_PUSH = 1e-3  # m: the end rules are checked after every millimetre of push (at most every 10 ms)
 
 
@@ -218,11 +239,14 @@ def run_insertion(case: InsertionCase, progress=None, snapshot_interval=None) ->
     last_push = [p for p in push.phases if p.name != SETTLE][-1]
     chunk_s = min(0.01, CHUNK_PUSH / case.push_speed)
     ended_by = None
-    settling = False
+    settling = at_rest = False
     while model.solver.time < push.duration - 1e-9:
         if not settling and push.settle_start is not None and model.solver.time >= push.settle_start:
-            settling = True  # the scope relaxes at rest with its own lateral damping (docs/model.md, "Loading")
-            model.rod.lateral_damping = case.settle_lateral_damping
+            settling = True
+            begin_settling(model)
+        if not at_rest and push.hold_start is not None and model.solver.time >= push.hold_start - 1e-12:
+            at_rest = True
+            bring_to_rest(model)
         step = min(chunk_s, push.duration - model.solver.time)
         model.solver.run(step, record_interval=case.record_interval_s, callbacks=[recorder], exact_end=False)
         if not recorder.rows or recorder.rows[-1]["time_s"] < model.solver.time:
