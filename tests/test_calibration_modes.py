@@ -129,12 +129,18 @@ def test_cli_joint_fit_and_one_line_errors(tmp_path, capsys):
     assert len(err) == 1 and "stress measure is not stated" in err[0]
 
 
-def test_insertion_refuses_an_ogden_material(tmp_path):
+def test_an_ogden_material_file_loads_for_the_insertion(tmp_path):
+    """The material.json of an Ogden joint fit, as ``colonsim calibrate`` writes it, is a wall
+    material of the insertion solver with the fitted parameters and mu0."""
     from colonsim.insertion.engine.material import load_material
 
-    path = _table(tmp_path, json.dumps({"law": "ogden_3", "units": "Pa", "parameters": {}}), "m.json")
-    with pytest.raises(ColonsimError, match="insertion shell runs the invariant laws only"):
-        load_material(path)
+    planar = TRELOAR_MANIFEST.parent / "planar.csv"
+    assert main(["calibrate", "--curve", str(planar), "--mode", "planar", "--law", "ogden_1", "--no-progress",
+                 "--out", str(tmp_path / "og")]) == 0
+    doc = json.loads((tmp_path / "og" / "material.json").read_text())
+    material = load_material(tmp_path / "og" / "material.json")
+    assert material.law == "ogden_1" and material.named_parameters == doc["parameters"]
+    assert material.mu0 == pytest.approx(doc["small_strain"]["mu0_Pa"], rel=1e-12)
 
 
 # The bundled colon calibration (mean curve, closed form, quick budget, seed 1) before the
