@@ -18,7 +18,8 @@ Ogden's law (:data:`OGDEN_LAWS`, 1 to 3 terms) is written in the principal stret
 Ogden's own convention (1972), the one the calibration fits and the insertion shell runs:
 ``W = sum_p mu_p / alpha_p (l1^alpha_p + l2^alpha_p + l3^alpha_p - 3)``, parameters
 ``(mu1, alpha1, mu2, alpha2, ...)`` with ``mu_p`` in Pa and ``alpha_p`` dimensionless, small-strain
-shear modulus ``mu0 = 1/2 sum_p mu_p alpha_p``. :func:`ogden` serves numpy and numba alike; all
+shear modulus ``mu0 = 1/2 sum_p mu_p alpha_p``. :func:`ogden` and :func:`ogden_hessian` serve numpy
+and numba alike (the calibration's FE strip, the shell's forces and its time step); all
 Ogden laws share one kernel index (the kernels read the number of terms from the parameter array).
 Other codes write the same law with other constants (:mod:`colonsim.identification.cards`).
 """
@@ -95,6 +96,27 @@ def ogden(l1, l2, p):
         t1 = t1 + mu * (l1**alpha - l3**alpha)
         t2 = t2 + mu * (l2**alpha - l3**alpha)
     return w, t1, t2
+
+
+def ogden_hessian(l1, l2, p):
+    """Second derivatives ``(W_11, W_12, W_22)`` of Ogden's reduced energy W(l1, l2, 1 / (l1 l2))
+    in the in-plane stretches (the thickness free of traction); its first derivatives are
+    ``W_i = t_i / l_i`` with ``t_i`` of :func:`ogden`:
+    ``W_ii = sum_p mu_p ((alpha_p - 1) l_i^(alpha_p - 2) + (alpha_p + 1) l3^alpha_p / l_i^2)``,
+    ``W_12 = sum_p mu_p alpha_p l3^alpha_p / (l1 l2)``.
+    """
+    l3 = 1.0 / (l1 * l2)
+    w11 = 0.0 * l1
+    w12 = 0.0 * l1
+    w22 = 0.0 * l1
+    for k in range(len(p) // 2):
+        mu = p[2 * k]
+        alpha = p[2 * k + 1]
+        l3a = l3**alpha
+        w11 = w11 + mu * ((alpha - 1.0) * l1 ** (alpha - 2.0) + (alpha + 1.0) * l3a / (l1 * l1))
+        w22 = w22 + mu * ((alpha - 1.0) * l2 ** (alpha - 2.0) + (alpha + 1.0) * l3a / (l2 * l2))
+        w12 = w12 + mu * alpha * l3a / (l1 * l2)
+    return w11, w12, w22
 
 
 def uniaxial_invariants(stretch):
@@ -188,6 +210,10 @@ class OgdenLaw:
     def principal(self, l1, l2, params):
         """``(W, t1, t2)`` of :func:`ogden` at in-plane principal stretches ``l1``, ``l2`` (arrays)."""
         return ogden(np.asarray(l1, dtype=float), np.asarray(l2, dtype=float), np.asarray(params, dtype=float))
+
+    def hessian(self, l1, l2, params):
+        """``(W_11, W_12, W_22)`` of :func:`ogden_hessian` at ``l1``, ``l2`` (arrays)."""
+        return ogden_hessian(np.asarray(l1, dtype=float), np.asarray(l2, dtype=float), np.asarray(params, dtype=float))
 
     def initial_shear_modulus(self, params) -> float:
         """Small-strain shear modulus mu0 = 1/2 sum_p mu_p alpha_p, Pa."""

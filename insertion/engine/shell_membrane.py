@@ -35,6 +35,7 @@ _mooney_rivlin_2 = _jit_law(laws.mooney_rivlin_2)
 _neo_hookean = _jit_law(laws.neo_hookean)
 _yeoh = _jit_law(laws.yeoh)
 _ogden = _jit_law(laws.ogden)
+_ogden_hessian = _jit_law(laws.ogden_hessian)
 _OGDEN = laws.OGDEN_INDEX
 _MOONEY_RIVLIN_3 = laws.LAWS["mooney_rivlin_3"].index
 _MOONEY_RIVLIN_2 = laws.LAWS["mooney_rivlin_2"].index
@@ -191,21 +192,15 @@ def _sym2_max_eig(a, b, c):
 
 @numba.njit(cache=True)
 def _ogden_principal_stress_tangent(a, b, params):
-    """:func:`_principal_stress_tangent` of Ogden's law. Its reduced energy in the principal values
-    (a, b) of C is sum mu/alpha (a^(alpha/2) + b^(alpha/2) + (a b)^(-alpha/2) - 3), so
-    2 dW/da = sum mu (a^(alpha/2 - 1) - a^(-alpha/2 - 1) b^(-alpha/2)),
-    4 d2W/da2 = 2 sum mu ((alpha/2 - 1) a^(alpha/2 - 2) + (alpha/2 + 1) a^(-alpha/2 - 2) b^(-alpha/2)),
-    4 d2W/dadb = sum mu alpha a^(-alpha/2 - 1) b^(-alpha/2 - 1)."""
-    s_a = 0.0
-    c_aa = 0.0
-    c_ab = 0.0
-    for k in range(len(params) // 2):
-        mu = params[2 * k]
-        h = 0.5 * params[2 * k + 1]
-        s_a += mu * (a ** (h - 1.0) - a ** (-h - 1.0) * b**-h)
-        c_aa += 2.0 * mu * ((h - 1.0) * a ** (h - 2.0) + (h + 1.0) * a ** (-h - 2.0) * b**-h)
-        c_ab += 2.0 * mu * h * (a * b) ** (-h - 1.0)
-    return s_a, c_aa, c_ab
+    """:func:`_principal_stress_tangent` of Ogden's law, from its derivatives in the stretches
+    l1 = sqrt(a), l2 = sqrt(b) (:func:`colonsim.laws.ogden_hessian`): with W_1 = t_1 / l1,
+    2 dW/da = t_1 / a, 4 d2W/da2 = (W_11 - t_1 / a) / a and 4 d2W/dadb = W_12 / (l1 l2)."""
+    l1 = math.sqrt(a)
+    l2 = math.sqrt(b)
+    _, t1, _ = _ogden(l1, l2, params)
+    w11, w12, _ = _ogden_hessian(l1, l2, params)
+    s_a = t1 / a
+    return s_a, (w11 - s_a) / a, w12 / (l1 * l2)
 
 
 @numba.njit(cache=True)
