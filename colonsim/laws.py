@@ -1,16 +1,17 @@
 """Incompressible isotropic hyperelastic laws of the colon wall: one pure energy function per law.
 
-Two kinds. Each invariant law (:data:`LAWS`) maps the invariants ``I1``, ``I2`` of the right Cauchy-Green tensor (``J = 1``) and its
-parameter sequence ``p`` (Pa, in the order of :attr:`Law.parameter_names`) to the strain-energy
-density ``W`` (J/m^3) and its partial derivatives ``(W, W1, W2, W11, W12, W22)``. Every stress and
-tangent of the project is built from these six numbers: the calibration's uniaxial and membrane
-models (numpy arrays) and the shell kernels of the insertion solver, where numba compiles the same
-functions (:mod:`colonsim.insertion.engine.shell_membrane`). The functions are plain arithmetic on
-``I1 - 3`` and ``I2 - 3`` so that both work unchanged; the physics is in docs/model.md.
+Two kinds. Each invariant law (:data:`LAWS`) maps the invariants ``I1``, ``I2`` of the right
+Cauchy-Green tensor (``J = 1``) and its parameter sequence ``p`` (Pa, in the order of
+:attr:`Law.parameter_names`) to the strain-energy density ``W`` (J/m^3) and its partial derivatives
+``(W, W1, W2, W11, W12, W22)``. Every stress and tangent of such a law is built from these six
+numbers: the calibration's uniaxial and membrane models (numpy arrays) and the shell kernels of the
+insertion solver, where numba compiles the same functions
+(:mod:`colonsim.insertion.engine.shell_membrane`). The functions are plain arithmetic on ``I1 - 3``
+and ``I2 - 3`` so that both work unchanged; the physics is in docs/model.md.
 
-Adding a law takes three steps: its function here, its entry in :data:`LAWS` (the next free
-``index``), and its branch in :func:`colonsim.insertion.engine.shell_membrane.law_derivatives`. The
-kernels dispatch on the index because a jitted function passed as a kernel argument misses numba's
+Adding an invariant law takes three steps: its function here, its entry in :data:`LAWS` (the next
+free ``index``), and its branch in :func:`colonsim.insertion.engine.shell_membrane.law_derivatives`.
+The kernels dispatch on the index because a jitted function passed as a kernel argument misses numba's
 cache in every new process. tests/test_wall_laws.py checks that every registered law is dispatched
 and that the compiled derivatives equal these.
 
