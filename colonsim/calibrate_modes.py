@@ -123,7 +123,7 @@ def calibrate_modes(request: ModeRequest, out: Path) -> list:
     """Fit, print, write; return the results (the chosen law's first with --compare-laws)."""
     from colonsim.files import check_output_folder
     from colonsim.identification.hyperelastic import CALIBRATION_LAWS, calibration_law
-    from colonsim.identification.joint import calibrate_joint
+    from colonsim.identification.joint import UnsolvableNearFit, calibrate_joint
     from colonsim.identification.joint_report import write_comparison, write_joint
     from colonsim.identification.search import Budget
 
@@ -142,10 +142,12 @@ def calibrate_modes(request: ModeRequest, out: Path) -> list:
                    stability_range=request.stability_range, strip_model=strip_model, mesh=request.mesh)
     print(f"fitting {len(curves)} curve(s) jointly: " + ", ".join(f"{c.name} ({c.mode})" for c in curves), flush=True)
     if request.compare_laws:
-        laws = [n for n, m in CALIBRATION_LAWS.items() if strip_model == "closed-form" or m.invariant is not None]
-        if len(laws) < len(CALIBRATION_LAWS):
-            print("Ogden laws skipped: the clamped FE strip runs the invariant laws only (--analytic fits them)")
-        results = {name: calibrate_joint(curves, name, **options) for name in laws}
+        results = {}
+        for name in CALIBRATION_LAWS:
+            try:
+                results[name] = calibrate_joint(curves, name, **options)
+            except UnsolvableNearFit as exc:
+                print(f"{name} left out: {exc}", flush=True)
         written = write_comparison(results, out)
         modes = {f"r2_{c.name}": f"R2 {c.mode}" for c in curves}
         shown = written["table"].set_index("law")[["drucker_stable", "first_unstable", *modes, "bic", "delta_bic"]]

@@ -6,8 +6,8 @@ at principal stretches ``l1, l2, l3 = 1 / (l1 l2)``: everything else follows fro
 
 - The invariant laws of :data:`colonsim.laws.LAWS` (the ones the insertion solver runs):
   ``t_i = 2 W1 (li^2 - l3^2) - 2 W2 (li^-2 - l3^-2)`` from their energy derivatives.
-- Ogden's law with 1 to 3 terms (calibration only: the insertion shell does not run it yet),
-  in Ogden's own convention (1972)::
+- Ogden's law with 1 to 3 terms (:data:`colonsim.laws.OGDEN_LAWS`, which the insertion shell
+  runs as well), in Ogden's own convention (1972), defined in :func:`colonsim.laws.ogden`::
 
       W = sum_p mu_p / alpha_p (l1^alpha_p + l2^alpha_p + l3^alpha_p - 3),  t_i = sum_p mu_p (li^alpha_p - l3^alpha_p)
 
@@ -38,7 +38,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from colonsim.errors import ColonsimError
-from colonsim.laws import LAWS, Law
+from colonsim.laws import LAWS, OGDEN_LAWS, Law, OgdenLaw
 
 MODES = ("uniaxial", "equibiaxial", "planar")
 
@@ -66,18 +66,21 @@ class CalibrationLaw:
     units : tuple of str
         ``"Pa"`` or ``"1"`` (dimensionless) per parameter.
     invariant : colonsim.laws.Law or None
-        The insertion solver's law behind it; None for a calibration-only law (Ogden).
+        The invariant law behind it; None for Ogden.
+    ogden : colonsim.laws.OgdenLaw or None
+        The Ogden law behind it; None for an invariant law.
     """
 
     name: str
     parameter_names: tuple
     units: tuple
     invariant: Law | None = None
+    ogden: OgdenLaw | None = None
 
     @property
     def terms(self) -> int:
         """Ogden terms (0 for an invariant law)."""
-        return 0 if self.invariant is not None else len(self.parameter_names) // 2
+        return 0 if self.ogden is None else self.ogden.terms
 
     def values(self, params) -> np.ndarray:
         if isinstance(params, dict):
@@ -94,8 +97,7 @@ class CalibrationLaw:
             i2 = l1**-2 + l2**-2 + l3**-2
             d = self.invariant(i1, i2, p)
             return tuple(2.0 * d.W1 * (li**2 - l3**2) - 2.0 * d.W2 * (li**-2 - l3**-2) for li in (l1, l2))
-        mu, alpha = p[0::2], p[1::2]
-        return tuple(sum(m * (li**a - l3**a) for m, a in zip(mu, alpha)) for li in (l1, l2))
+        return tuple(self.ogden.principal(l1, l2, p)[1:])
 
     def energy(self, l1, l2, params):
         """Strain-energy density W, J/m^3, at stretches l1, l2 (l3 = 1/(l1 l2))."""
@@ -104,7 +106,7 @@ class CalibrationLaw:
         l3 = 1.0 / (l1 * l2)
         if self.invariant is not None:
             return self.invariant(l1**2 + l2**2 + l3**2, l1**-2 + l2**-2 + l3**-2, p).W
-        return sum(m / a * (l1**a + l2**a + l3**a - 3.0) for m, a in zip(p[0::2], p[1::2]))
+        return self.ogden.principal(l1, l2, p)[0]
 
     def nominal_stress(self, mode, stretch, params):
         """Nominal (first Piola) stress along the stretch of ``mode``, Pa: P = (sigma_1 - sigma_3) / l1."""
@@ -116,26 +118,19 @@ class CalibrationLaw:
         p = self.values(params)
         if self.invariant is not None:
             return self.invariant.initial_shear_modulus(p)
-        return float(0.5 * np.sum(p[0::2] * p[1::2]))
+        return self.ogden.initial_shear_modulus(p)
 
     def shear_modulus_gradient(self, params) -> np.ndarray:
         """d mu0 / d params (linear for the invariant laws, 1/2 (alpha_p, mu_p) per Ogden term)."""
         p = self.values(params)
         if self.invariant is not None:
             return np.array([self.invariant.initial_shear_modulus(e) for e in np.eye(p.size)])
-        g = np.empty_like(p)
-        g[0::2], g[1::2] = 0.5 * p[1::2], 0.5 * p[0::2]
-        return g
-
-
-def _ogden(terms):
-    names = tuple(n for i in range(1, terms + 1) for n in (f"mu{i}", f"alpha{i}"))
-    return CalibrationLaw(f"ogden_{terms}", names, ("Pa", "1") * terms)
+        return self.ogden.shear_modulus_gradient(p)
 
 
 CALIBRATION_LAWS = {
     **{name: CalibrationLaw(name, law.parameter_names, ("Pa",) * len(law.parameter_names), law) for name, law in LAWS.items()},
-    **{f"ogden_{n}": _ogden(n) for n in (1, 2, 3)},
+    **{name: CalibrationLaw(name, law.parameter_names, law.units, ogden=law) for name, law in OGDEN_LAWS.items()},
 }
 
 

@@ -25,7 +25,7 @@ evaluations are recorded as stage ``least-squares``. The uncertainty the lineari
 :mod:`colonsim.identification.uncertainty`. A uniaxial strip given as force and displacement is
 read through its geometry (:func:`colonsim.identification.stress_curves.from_strip`); with
 ``strip_model="fe"`` its prediction is the clamped FE strip's force over the section instead of
-the closed form (invariant laws only: the FE strip does not carry Ogden).
+the closed form (every law, Ogden's included).
 
 Parameter bounds come from the data: with G the largest secant modulus of the curves read as a
 neo-Hookean solid (:func:`characteristic_modulus`) and a the largest ``I1 - 3`` the tests reach,
@@ -55,6 +55,12 @@ from colonsim.identification.stress_curves import ModeCurve
 from colonsim.identification.uncertainty import FitUncertainty, fit_uncertainty
 
 RESIDUALS = ("relative", "absolute")
+
+
+class UnsolvableNearFit(ColonsimError):
+    """The clamped FE strip cannot be solved next to the fitted parameters (so no uncertainty):
+    a law that fits only at the edge of what the strip can carry (Ogden terms of opposite sign
+    cancelling each other)."""
 RELATIVE_FLOOR = 0.1  # of the curve's peak stress
 POLISH_STARTS = 10
 STRIP_POINTS = 20  # stretches at which a force-displacement strip is compared (as the strip fit's --points)
@@ -109,9 +115,6 @@ class JointObjective:
             raise ColonsimError(f"--residuals {residuals!r}: use absolute or relative")
         if strip_model not in ("closed-form", "fe"):
             raise ColonsimError(f"strip model {strip_model!r}: use closed-form or fe")
-        if strip_model == "fe" and self.law.invariant is None:
-            raise ColonsimError(f"{self.law.name}: the clamped FE strip runs the invariant laws only; fit Ogden with "
-                                "the closed form (--analytic)")
         self.curves, self.residuals, self.strip_model = list(curves), residuals, strip_model
         if not self.curves:
             raise ColonsimError("no curves to fit")
@@ -130,8 +133,8 @@ class JointObjective:
             model = None
             if strip_model == "fe" and c.strip is not None:
                 s = c.strip
-                model = ClampedStripModel(s.length, s.width, s.thickness, self.law.invariant, n_length=mesh[0],
-                                          n_width=mesh[1])
+                model = ClampedStripModel(s.length, s.width, s.thickness, self.law.invariant or self.law.ogden,
+                                          n_length=mesh[0], n_width=mesh[1])
             self.pieces.append(_Piece(c, stretch, stress, c.weight / (base * np.sqrt(stress.size)), model))
         self.target = np.concatenate([p.scale * p.stress for p in self.pieces])
 
@@ -243,7 +246,12 @@ def calibrate_joint(curves, law, residuals="relative", budget: Budget | None = N
         outcome = search(problem, names, bounds, initial, budget, seed, progress)
     theta, history, stages = polish(objective, outcome, bounds, names)
     scales = np.array([hi - lo for lo, hi in bounds.values()])
-    unc = fit_uncertainty(objective.simulate, objective.target, theta, names, scales)
+    try:
+        unc = fit_uncertainty(objective.simulate, objective.target, theta, names, scales)
+    except FEConvergenceError as exc:
+        raise UnsolvableNearFit(f"{model.name}: the clamped FE strip cannot be solved next to the fitted parameters "
+                                f"({exc}), so their uncertainty is unknown; fit {model.name} in closed form "
+                                "(--analytic) or choose another law") from None
     rows, fitted = [], []
     for piece, pred in zip(objective.pieces, objective.predictions(theta)):
         c = piece.curve

@@ -10,8 +10,8 @@ Layout of the output folder::
     modes.png        every mode's data and fit, residuals below
     laws.csv, laws.png, laws/<law>/   with --compare-laws: one row per law (stability included)
 
-An Ogden material file is for the calibration and for export; the insertion solver refuses it
-(its shell runs the invariant laws only).
+Every law's material file, Ogden's included, runs in the insertion solver (``colonsim insert
+--material``) and exports to other solvers' cards.
 """
 
 from __future__ import annotations
@@ -58,8 +58,6 @@ def material_document(result: JointResult, selection=None, level=0.95) -> dict:
         "provenance": {"tool": "colonsim calibrate (joint)", **code_version(),
                        "date": _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds"), **result.settings},
     }
-    if law.invariant is None:
-        doc["insertion_solver"] = "not runnable: the insertion shell runs the invariant laws only"
     if selection is not None:
         doc["law_selection"] = selection
     return doc

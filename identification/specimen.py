@@ -22,7 +22,7 @@ from scipy.sparse.linalg import splu
 from skfem import Basis, ElementTriP1, ElementTriP2, MeshTri
 
 from colonsim.errors import ColonsimError
-from colonsim.laws import get_law
+from colonsim.laws import get_wall_law
 from colonsim.identification.membrane import membrane_stress
 
 
@@ -37,8 +37,9 @@ class ClampedStripModel:
     ----------
     length, width, thickness : float
         Free length between the grips, width and wall thickness of the strip, m.
-    law : Law or str
-        Hyperelastic law (:data:`colonsim.laws.LAWS`), default 3-parameter Mooney-Rivlin.
+    law : Law, OgdenLaw or str
+        Hyperelastic law (:data:`colonsim.laws.WALL_LAWS`, Ogden's included), default 3-parameter
+        Mooney-Rivlin.
     grips : {"clamped", "sliding"}
         Clamped grips forbid lateral motion at the gripped edges (the real test).
     n_length, n_width : int
@@ -60,7 +61,7 @@ class ClampedStripModel:
         if grips not in ("clamped", "sliding"):
             raise ColonsimError(f"grips must be 'clamped' or 'sliding', got {grips!r}")
         self.length, self.width, self.thickness = float(length), float(width), float(thickness)
-        self.law = get_law(law) if isinstance(law, str) else law
+        self.law = get_wall_law(law) if isinstance(law, str) else law
         self.grips = grips
         self.n_length, self.n_width, self.order = int(n_length), int(n_width), int(order)
 

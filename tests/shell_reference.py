@@ -2,7 +2,8 @@
 
 The solver uses one fused kernel (``Shell.internal_forces``); these element-by-element kernels
 compute the two parts apart, so tests can check each against theory and the fused kernel
-against their sum.
+against their sum. Like the fused kernel, they compile in the membrane of every law (Ogden's
+branch included) from shell_membrane.py: after editing that file delete ``tests/__pycache__``.
 """
 
 import numba

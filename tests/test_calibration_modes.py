@@ -129,12 +129,44 @@ def test_cli_joint_fit_and_one_line_errors(tmp_path, capsys):
     assert len(err) == 1 and "stress measure is not stated" in err[0]
 
 
-def test_insertion_refuses_an_ogden_material(tmp_path):
+def test_compare_laws_leaves_out_a_law_the_fe_strip_cannot_solve_near_its_fit(tmp_path, capsys, monkeypatch):
+    """A law whose fit the clamped FE strip cannot be solved next to (the uncertainty's Jacobian
+    needs that) is left out of --compare-laws with a line saying why, and the others are compared
+    (here the failure is injected for the Ogden laws, on a closed-form curve, to keep it fast)."""
+    import colonsim.identification.joint as joint
+    from colonsim.identification.specimen import FEConvergenceError
+
+    fit_uncertainty = joint.fit_uncertainty
+
+    def failing_for_ogden(simulate, target, theta, names, scales):
+        if "mu1" in names:
+            raise FEConvergenceError("an element inverted during Newton iterations")
+        return fit_uncertainty(simulate, target, theta, names, scales)
+
+    monkeypatch.setattr(joint, "fit_uncertainty", failing_for_ogden)
+    fast = {name: CALIBRATION_LAWS[name] for name in ("mooney_rivlin_3", "neo_hookean", "ogden_1")}
+    monkeypatch.setattr("colonsim.identification.hyperelastic.CALIBRATION_LAWS", fast)
+    planar = TRELOAR_MANIFEST.parent / "planar.csv"
+    assert main(["calibrate", "--curve", str(planar), "--mode", "planar", "--compare-laws", "--no-progress",
+                 "--out", str(tmp_path / "cmp")]) == 0
+    out = capsys.readouterr().out
+    assert "ogden_1 left out: ogden_1: the clamped FE strip cannot be solved next to the fitted parameters" in out
+    table = (tmp_path / "cmp" / "laws.csv").read_text()
+    assert "mooney_rivlin_3" in table and "neo_hookean" in table and "ogden" not in table
+
+
+def test_an_ogden_material_file_loads_for_the_insertion(tmp_path):
+    """The material.json of an Ogden joint fit, as ``colonsim calibrate`` writes it, is a wall
+    material of the insertion solver with the fitted parameters and mu0."""
     from colonsim.insertion.engine.material import load_material
 
-    path = _table(tmp_path, json.dumps({"law": "ogden_3", "units": "Pa", "parameters": {}}), "m.json")
-    with pytest.raises(ColonsimError, match="insertion shell runs the invariant laws only"):
-        load_material(path)
+    planar = TRELOAR_MANIFEST.parent / "planar.csv"
+    assert main(["calibrate", "--curve", str(planar), "--mode", "planar", "--law", "ogden_1", "--no-progress",
+                 "--out", str(tmp_path / "og")]) == 0
+    doc = json.loads((tmp_path / "og" / "material.json").read_text())
+    material = load_material(tmp_path / "og" / "material.json")
+    assert material.law == "ogden_1" and material.named_parameters == doc["parameters"]
+    assert material.mu0 == pytest.approx(doc["small_strain"]["mu0_Pa"], rel=1e-12)
 
 
 # The bundled colon calibration (mean curve, closed form, quick budget, seed 1) before the
@@ -161,5 +193,11 @@ def test_a_strip_enters_joint_fits_through_the_clamped_fe_model():
     fe = JointObjective([strip], "mooney_rivlin_3", strip_model="fe", mesh=(4, 2)).predictions(params)[0]
     closed = JointObjective([strip], "mooney_rivlin_3").predictions(params)[0]
     assert np.all(fe > closed) and np.max(fe / closed - 1) < 0.05  # the clamp stiffens by a few %
-    with pytest.raises(ColonsimError, match="FE strip runs the invariant laws only"):
-        JointObjective([strip], "ogden_2", strip_model="fe")
+    # Ogden goes through the same FE strip: one term with alpha = 2 is neo-Hookean (mu = 2 C10)
+    # to the Newton tolerance, and a stiffening Ogden law is stiffened by the clamp likewise
+    nh = JointObjective([strip], "neo_hookean", strip_model="fe", mesh=(4, 2)).predictions([43e3])[0]
+    og = JointObjective([strip], "ogden_1", strip_model="fe", mesh=(4, 2)).predictions([86e3, 2.0])[0]
+    assert np.allclose(og, nh, rtol=1e-8, atol=0.0)
+    fe = JointObjective([strip], "ogden_1", strip_model="fe", mesh=(4, 2)).predictions([22933.0, 8.2667])[0]
+    closed = JointObjective([strip], "ogden_1").predictions([22933.0, 8.2667])[0]
+    assert np.all(fe > closed) and np.max(fe / closed - 1) < 0.05

@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 
 from colonsim.errors import ColonsimError
-from colonsim.insertion.engine.material import REFERENCE_MATERIAL_PATH, WallMaterial, load_material
-from colonsim.laws import LAWS
+from colonsim.insertion.engine.material import REFERENCE_MATERIAL_PATH, SoftWallWarning, WallMaterial, load_material
+from colonsim.laws import LAWS, OGDEN_LAWS
 
 
 def write(tmp_path, data, name="mat.json"):
@@ -57,6 +57,38 @@ def test_every_law_loads(tmp_path, law):
     assert mat.law == law and mat.parameters == tuple(params.values())
     assert mat.mu0 == pytest.approx(LAWS[law].initial_shear_modulus(mat.parameters), rel=1e-15)
     assert mat.E0 == pytest.approx(3.0 * mat.mu0, rel=1e-15)
+
+
+OGDEN_3 = {"mu1": 20e3, "alpha1": 2.0, "mu2": 2e3, "alpha2": 10.0, "mu3": -10e3, "alpha3": -2.0}
+
+
+@pytest.mark.parametrize("law", sorted(OGDEN_LAWS))
+def test_ogden_files_load(tmp_path, law):
+    """An Ogden file (mu_p in Pa of either sign, alpha_p dimensionless) loads for the insertion,
+    with mu0 = 1/2 sum mu_p alpha_p (Ogden's own convention, the calibration's)."""
+    terms = OGDEN_LAWS[law].terms
+    params = dict(list(OGDEN_3.items())[:2 * terms])
+    mat = load_material(write(tmp_path, good(law=law, parameters=params)))
+    assert mat.law == law and mat.named_parameters == params
+    expected = {1: 20e3, 2: 30e3, 3: 40e3}[terms]  # 20e3 * 2/2, + 2e3 * 10/2, + (-10e3)(-2)/2
+    assert mat.mu0 == pytest.approx(expected, rel=1e-15) and mat.E0 == pytest.approx(3 * expected, rel=1e-15)
+
+
+def test_ogden_file_errors(tmp_path):
+    ogden_3 = good(law="ogden_3", parameters=OGDEN_3)
+    with pytest.raises(ColonsimError, match="misses parameter.*alpha3; give mu1, alpha1, mu2, alpha2, mu3, alpha3"):
+        load_material(write(tmp_path, {**ogden_3, "parameters": {k: v for k, v in OGDEN_3.items() if k != "alpha3"}}))
+    with pytest.raises(ColonsimError, match="C10 do not belong to law ogden_3"):
+        load_material(write(tmp_path, {**ogden_3, "parameters": {**OGDEN_3, "C10": 1.0}}))
+    with pytest.raises(ColonsimError, match="ogden_3 exponent alpha2 = 0 leaves its term undefined"):
+        load_material(write(tmp_path, {**ogden_3, "parameters": {**OGDEN_3, "alpha2": 0.0}}))
+    with pytest.raises(ColonsimError, match="ogden_3 parameter mu1 = inf must be finite"):
+        WallMaterial("ogden_3", (np.inf, 2.0, 2e3, 10.0, -10e3, -2.0))
+    with pytest.raises(ColonsimError, match="mu0 = -1000.0 Pa must be > 0"):
+        WallMaterial("ogden_1", (-1e3, 2.0))
+    with pytest.warns(SoftWallWarning, match="mu0 = 40 Pa"):  # the parameters given in kPa
+        load_material(write(tmp_path, {**ogden_3, "parameters": {k: v / 1e3 if k.startswith("mu") else v
+                                                                 for k, v in OGDEN_3.items()}}))
 
 
 def test_uniaxial_stress_matches_numerical_derivative_of_energy():

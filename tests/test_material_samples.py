@@ -178,6 +178,11 @@ def test_results_rows_carry_the_material_columns(tmp_path):
     yeoh = material_file(tmp_path, [30_000.0, 1_000.0, 100.0], None, "yeoh.json", "yeoh", ("C10", "C20", "C30"))
     row = material_columns(InsertionCase(material=str(yeoh)))
     assert row[WALL_MU0] == pytest.approx(60.0) and math.isnan(row[WALL_C11])
+    # Ogden: mu0 = 1/2 sum mu_p alpha_p
+    ogden = material_file(tmp_path, [20_000.0, 2.0, -10_000.0, -2.0], None, "ogden.json", "ogden_2",
+                          ("mu1", "alpha1", "mu2", "alpha2"))
+    row = material_columns(InsertionCase(material=str(ogden)))
+    assert row[WALL_MU0] == pytest.approx(30.0) and math.isnan(row[WALL_C11])
 
 
 def test_tissue_columns_are_the_laws_small_strain_modulus():

@@ -1,7 +1,8 @@
 """Colon wall material: an incompressible hyperelastic law of :mod:`colonsim.laws` read from JSON.
 
-The calibration workflow writes a material file (``"law"``: any of :data:`colonsim.laws.LAWS`,
-parameters in Pa); the insertion model reads it here and its shell runs that law. A reference copy
+The calibration workflow writes a material file (``"law"``: any of :data:`colonsim.laws.WALL_LAWS`,
+the invariant laws and Ogden's with 1 to 3 terms; parameters in Pa, Ogden's exponents
+dimensionless); the insertion model reads it here and its shell runs that law. A reference copy
 holding the source's identified three-parameter Mooney-Rivlin parameters ships with the
 repository (:data:`REFERENCE_MATERIAL_PATH`).
 """
@@ -14,7 +15,7 @@ from pathlib import Path
 
 from colonsim.data import REFERENCE_MATERIAL_PATH
 from colonsim.errors import ColonsimError, ColonsimWarning
-from colonsim.laws import LAWS, Law, get_law
+from colonsim.laws import WALL_LAWS, Law, OgdenLaw, get_wall_law
 
 # Small-strain shear modulus below which a wall is softer than any soft tissue: the softest
 # (brain, fat) are near 1 kPa, the reference colon wall 87 kPa. Below this, parameters were most
@@ -33,18 +34,21 @@ class WallMaterial:
     Parameters
     ----------
     law : str
-        Name of the law, one of :data:`colonsim.laws.LAWS`.
+        Name of the law, one of :data:`colonsim.laws.WALL_LAWS`.
     parameters : sequence of float
-        The law's parameters in the order of its ``parameter_names``, Pa. All finite and
-        non-negative (the calibration's bounds), with a positive small-strain shear modulus.
+        The law's parameters in the order of its ``parameter_names`` (Pa; Ogden's exponents
+        dimensionless), all finite, with a positive small-strain shear modulus. An invariant law's
+        are non-negative (the strip calibration's bounds); Ogden's ``mu_p`` and ``alpha_p`` take
+        either sign (a multi-mode fit's third term has a negative exponent), ``alpha_p`` not 0.
     """
 
     law: str
     parameters: tuple[float, ...]
 
     def __post_init__(self):
-        model = get_law(self.law)
+        model = get_wall_law(self.law)
         names = model.parameter_names
+        signed = isinstance(model, OgdenLaw)
         values = tuple(self.parameters)
         if len(values) != len(names):
             raise ColonsimError(f"law {self.law} takes {len(names)} parameter(s) ({', '.join(names)}), got "
@@ -53,7 +57,13 @@ class WallMaterial:
             if isinstance(value, bool) or not isinstance(value, (int, float)):
                 raise ColonsimError(f"{self.law} parameter {name} must be a number in Pa, got {value!r}; "
                                     "fix the material parameters.")
-            if not math.isfinite(value) or value < 0.0:
+            if signed and not math.isfinite(value):
+                raise ColonsimError(f"{self.law} parameter {name} = {value!r} must be finite; fix the material "
+                                    "parameters.")
+            if signed and name.startswith("alpha") and value == 0.0:
+                raise ColonsimError(f"{self.law} exponent {name} = 0 leaves its term undefined (mu / alpha); fix the "
+                                    "material parameters.")
+            if not signed and (not math.isfinite(value) or value < 0.0):
                 raise ColonsimError(f"{self.law} parameter {name} = {value!r} Pa must be finite and >= 0; "
                                     "fix the material parameters.")
         object.__setattr__(self, "parameters", tuple(float(v) for v in values))
@@ -62,9 +72,9 @@ class WallMaterial:
                                 "small-strain stiffness); fix the material parameters.")
 
     @property
-    def law_model(self) -> Law:
+    def law_model(self) -> Law | OgdenLaw:
         """The law's registry entry (energy function, parameter names, kernel index)."""
-        return LAWS[self.law]
+        return WALL_LAWS[self.law]
 
     @property
     def named_parameters(self) -> dict:
@@ -73,7 +83,7 @@ class WallMaterial:
 
     @property
     def mu0(self):
-        """Small-strain shear modulus 2 (W1 + W2) at rest, Pa."""
+        """Small-strain shear modulus, Pa: 2 (W1 + W2) at rest, 1/2 sum mu_p alpha_p for Ogden."""
         return self.law_model.initial_shear_modulus(self.parameters)
 
     @property
@@ -110,13 +120,14 @@ def read_material_document(path) -> dict:
 
 
 def load_material(path):
-    """Read a material file of any law of :data:`colonsim.laws.LAWS`.
+    """Read a material file of any law of :data:`colonsim.laws.WALL_LAWS`.
 
     Parameters
     ----------
     path : str or Path
-        JSON file with ``"law"`` (e.g. ``"mooney_rivlin_3"``), ``"units": "Pa"`` and
-        ``"parameters"`` of that law by name (``{"C10": .., "C01": .., "C11": ..}``).
+        JSON file with ``"law"`` (e.g. ``"mooney_rivlin_3"``, ``"ogden_3"``), ``"units": "Pa"`` and
+        ``"parameters"`` of that law by name (``{"C10": .., "C01": .., "C11": ..}``,
+        ``{"mu1": .., "alpha1": .., ...}``).
 
     Returns
     -------
@@ -130,14 +141,11 @@ def load_material(path):
     path = Path(path)
     data = read_material_document(path)
     law = data.get("law")
-    if isinstance(law, str) and law.startswith("ogden_"):
-        raise ColonsimError(f"material file {path} has law {law!r}: the insertion shell runs the invariant laws only "
-                            f"({', '.join(LAWS)}), not Ogden yet; calibrate one of those for an insertion.")
-    if not isinstance(law, str) or law not in LAWS:
+    if not isinstance(law, str) or law not in WALL_LAWS:
         raise ColonsimError(
-            f"material file {path} has law {law!r}; use one of {', '.join(LAWS)} (the laws the calibration fits)."
+            f"material file {path} has law {law!r}; use one of {', '.join(WALL_LAWS)} (the laws the calibration fits)."
         )
-    names = LAWS[law].parameter_names
+    names = WALL_LAWS[law].parameter_names
     units = data.get("units", "Pa")
     if units != "Pa":
         raise ColonsimError(

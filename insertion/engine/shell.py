@@ -1,7 +1,7 @@
 """The colon wall as a thin hyperelastic shell: the body the solver integrates.
 
 Membrane (:mod:`colonsim.insertion.engine.shell_membrane`, constant-strain triangles of any
-calibrated law), bending (:mod:`colonsim.insertion.engine.shell_hinges`, discrete hinges) and a
+calibrated law: the invariant laws and Ogden's in the principal stretches), bending (:mod:`colonsim.insertion.engine.shell_hinges`, discrete hinges) and a
 follower pressure, with lumped masses and a stable time step; docs/model.md for the physics.
 
 All kernels are ``numba`` functions over raw arrays; the per-element buffers are summed onto nodes

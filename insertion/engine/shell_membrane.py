@@ -5,12 +5,20 @@ thickness stretch lambda_3^2 = 1/det C, so I1 = tr C + 1/det C and I2 = tr C/det
 reduced energy W(C) already contains the zero through-thickness stress, and S = 2 dW/dC
 (docs/model.md).
 
-The law is any of :data:`colonsim.laws.LAWS`, passed to the kernels as its index and a float64
-parameter array: :func:`law_derivatives` compiles the laws' own energy functions and dispatches
-on the index (a jitted function as a kernel argument would be recompiled in every process).
-Adding a law: its function and entry in :mod:`colonsim.laws`, and its branch here. Numba's cache
-only watches each kernel's own file: after editing a law in colonsim/laws.py, delete this
-folder's ``__pycache__`` (tests/test_wall_laws.py fails on a stale compiled law).
+The law is any of :data:`colonsim.laws.WALL_LAWS`, passed to the kernels as its index and a
+float64 parameter array: :func:`law_derivatives` compiles the invariant laws' own energy functions
+and dispatches on the index (a jitted function as a kernel argument would be recompiled in every
+process). Adding an invariant law: its function and entry in :mod:`colonsim.laws`, and its branch
+here. Numba's cache only watches each kernel's own file: after editing a law in colonsim/laws.py,
+delete this folder's ``__pycache__`` (tests/test_wall_laws.py fails on a stale compiled law).
+
+Ogden's law (:func:`colonsim.laws.ogden`) is a function of the principal stretches, not of the
+invariants, and has its own branch (:func:`_ogden_membrane_stress`): the eigenvalues c_a >= c_b of
+C give the in-plane stretches l_i = sqrt(c_i), the law the differences t_i = sigma_i - sigma_3, and
+the principal second Piola-Kirchhoff stresses are S_i = t_i / l_i^2 along C's eigenvectors. The
+projector on the first eigenvector, N = (C - c_b I) / (c_a - c_b), has entries bounded by 1 however
+close c_a and c_b come, so S = S_b I + (S_a - S_b) N never divides by a vanishing difference; at
+c_a = c_b exactly S is isotropic, S_a I.
 """
 
 import math
@@ -26,6 +34,9 @@ _mooney_rivlin_3 = _jit_law(laws.mooney_rivlin_3)
 _mooney_rivlin_2 = _jit_law(laws.mooney_rivlin_2)
 _neo_hookean = _jit_law(laws.neo_hookean)
 _yeoh = _jit_law(laws.yeoh)
+_ogden = _jit_law(laws.ogden)
+_ogden_hessian = _jit_law(laws.ogden_hessian)
+_OGDEN = laws.OGDEN_INDEX
 _MOONEY_RIVLIN_3 = laws.LAWS["mooney_rivlin_3"].index
 _MOONEY_RIVLIN_2 = laws.LAWS["mooney_rivlin_2"].index
 _NEO_HOOKEAN = laws.LAWS["neo_hookean"].index
@@ -49,8 +60,9 @@ def law_derivatives(law, p, i1, i2):
 
 
 def check_dispatched(law, params):
-    """Raise if the kernels have no branch for ``law`` (a :class:`colonsim.laws.Law`)."""
-    if not np.isfinite(law_derivatives(law.index, params, 3.0, 3.0)[1]):
+    """Raise if the kernels have no branch for ``law`` (of :data:`colonsim.laws.WALL_LAWS`): its
+    membrane stress in a stretched state must be finite."""
+    if not np.all(np.isfinite(_membrane_stress(1.2, 0.05, 0.9, law.index, params))):
         raise ColonsimError(f"the shell kernels do not dispatch law {law.name} (index {law.index}); add its branch "
                             "to colonsim.insertion.engine.shell_membrane.law_derivatives.")
 
@@ -86,8 +98,30 @@ def reference_frames(nodes, triangles):
 
 
 @numba.njit(cache=True, inline="always")
+def _ogden_membrane_stress(c00, c01, c11, p):
+    """W and S = 2 dW/dC of Ogden's law (parameters ``p``) for C = [[c00, c01], [c01, c11]], det C > 0."""
+    half_diff = 0.5 * (c00 - c11)
+    disc = math.sqrt(half_diff * half_diff + c01 * c01)
+    ca = 0.5 * (c00 + c11) + disc
+    cb = (c00 * c11 - c01 * c01) / ca  # det C / c_a: no cancellation when c_b << c_a
+    w, ta, tb = _ogden(math.sqrt(ca), math.sqrt(cb), p)
+    sa = ta / ca
+    sb = tb / cb
+    if disc > 0.0:
+        # projector on C's first eigenvector: (C - c_b I) / (c_a - c_b), entries in [-1, 1]
+        n00 = 0.5 + 0.5 * half_diff / disc
+        n11 = 0.5 - 0.5 * half_diff / disc
+        n01 = 0.5 * c01 / disc
+        ds = sa - sb
+        return w, sb + ds * n00, ds * n01, sb + ds * n11
+    return w, sa, 0.0, sa  # equal stretches: isotropic in-plane stress
+
+
+@numba.njit(cache=True, inline="always")
 def _membrane_stress(c00, c01, c11, law, p):
     """Reduced energy density W and S = 2 dW/dC for a 2x2 C = [[c00, c01], [c01, c11]]."""
+    if law == _OGDEN:
+        return _ogden_membrane_stress(c00, c01, c11, p)
     det = c00 * c11 - c01 * c01
     inv_det = 1.0 / det
     tr = c00 + c11
@@ -157,9 +191,24 @@ def _sym2_max_eig(a, b, c):
 
 
 @numba.njit(cache=True)
+def _ogden_principal_stress_tangent(a, b, params):
+    """:func:`_principal_stress_tangent` of Ogden's law, from its derivatives in the stretches
+    l1 = sqrt(a), l2 = sqrt(b) (:func:`colonsim.laws.ogden_hessian`): with W_1 = t_1 / l1,
+    2 dW/da = t_1 / a, 4 d2W/da2 = (W_11 - t_1 / a) / a and 4 d2W/dadb = W_12 / (l1 l2)."""
+    l1 = math.sqrt(a)
+    l2 = math.sqrt(b)
+    _, t1, _ = _ogden(l1, l2, params)
+    w11, w12, _ = _ogden_hessian(l1, l2, params)
+    s_a = t1 / a
+    return s_a, (w11 - s_a) / a, w12 / (l1 * l2)
+
+
+@numba.njit(cache=True)
 def _principal_stress_tangent(p, q, law, params):
     """S_1 = 2 dW/da and the second derivatives 4 d2W/da2, 4 d2W/dadb of the reduced energy in
     the principal values (a, b) = (p, q) of C."""
+    if law == _OGDEN:
+        return _ogden_principal_stress_tangent(p, q, params)
     # I1 = a + b + 1/(ab); I2 = 1/a + 1/b + ab
     i1 = p + q + 1.0 / (p * q)
     i2 = 1.0 / p + 1.0 / q + p * q

@@ -27,8 +27,8 @@ in ``InsertionCase.material_parameters`` and the file in ``material`` (which set
 
 :func:`material_columns` gives every results row its material's small-strain shear modulus and
 C11 in kPa (:data:`colonsim.catalog.WALL_MU0`, :data:`colonsim.catalog.WALL_C11`), the default
-material included; a law without a C11 term (neo-Hookean, two-parameter Mooney-Rivlin, Yeoh) gets
-NaN there, and the surrogate leaves an input that is NaN in every run out.
+material included; a law without a C11 term (neo-Hookean, two-parameter Mooney-Rivlin, Yeoh, Ogden)
+gets NaN there, and the surrogate leaves an input that is NaN in every run out.
 """
 
 from __future__ import annotations
@@ -45,7 +45,7 @@ import numpy as np
 from colonsim.catalog import WALL_C11, WALL_MU0
 from colonsim.errors import ColonsimError
 from colonsim.inputs import check_input
-from colonsim.laws import get_law
+from colonsim.laws import OgdenLaw, get_wall_law
 from colonsim.insertion.case.case_material import case_material
 from colonsim.insertion.engine.material import read_material_document
 
@@ -142,12 +142,15 @@ def read_population(path) -> Population:
 
 def tissue_columns(law: str, values) -> dict:
     """The surrogate's tissue inputs of parameter rows ``values`` (n, p) in Pa of ``law``: mu0 and
-    C11 in kPa (C11 NaN for a law without it)."""
-    model = get_law(law)
+    C11 in kPa (C11 NaN for a law without it, Ogden's included)."""
+    model = get_wall_law(law)
     p = np.atleast_2d(np.asarray(values, dtype=float))
-    rest = np.full(len(p), 3.0)
-    d = model.energy(rest, rest, tuple(p.T))  # (W, W1, W2, ...) at I1 = I2 = 3
-    mu0 = 2.0 * (np.asarray(d[1]) + np.asarray(d[2])) / 1e3
+    if isinstance(model, OgdenLaw):
+        mu0 = np.array([model.initial_shear_modulus(row) for row in p]) / 1e3
+    else:
+        rest = np.full(len(p), 3.0)
+        d = model.energy(rest, rest, tuple(p.T))  # (W, W1, W2, ...) at I1 = I2 = 3
+        mu0 = 2.0 * (np.asarray(d[1]) + np.asarray(d[2])) / 1e3
     names = model.parameter_names
     c11 = p[:, names.index("C11")] / 1e3 if "C11" in names else np.full(len(p), np.nan)
     return {WALL_MU0: mu0, WALL_C11: c11}
