@@ -262,6 +262,9 @@ def get_wall_law(name: str) -> Law | OgdenLaw:
 
 def get_law(name: str) -> Law:
     """Look a law up by name, with an error listing the known ones."""
+    if isinstance(name, str) and name in OGDEN_LAWS:
+        raise ColonsimError(f"law {name!r} is fitted through a manifest (--manifest FILE with a mode column, "
+                            f"docs/calibration.md); a single curve fits {', '.join(sorted(LAWS))}")
     try:
         return LAWS[name]
     except (KeyError, TypeError):

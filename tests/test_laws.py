@@ -36,6 +36,11 @@ def test_unknown_law_names_the_choices():
         get_law("ogden")
 
 
+def test_an_ogden_law_on_a_single_curve_points_to_the_manifest():
+    with pytest.raises(ColonsimError, match="'ogden_2' is fitted through a manifest .*--manifest"):
+        get_law("ogden_2")
+
+
 def test_uniaxial_invariants_incompressible():
     i1, i2 = uniaxial_invariants(1.5)
     assert (i1, i2) == pytest.approx((1.5**2 + 2 / 1.5, 2 * 1.5 + 1 / 1.5**2))
