@@ -32,7 +32,6 @@ from pathlib import Path
 
 import numpy as np
 import pandas as pd
-from scipy.optimize import minimize
 from scipy.stats import norm
 from threadpoolctl import threadpool_limits
 
@@ -72,18 +71,16 @@ class JointReplicateGP(GaussianProcess):
         starts = self._starts(Xs.shape[1], len(ys)) if starts is None else starts
         free = slice(None) if fixed_noise is None else slice(0, -1)
 
-        def objective(t):
+        def value_and_gradient(t):
             theta = t if fixed_noise is None else np.append(t, fixed_noise)
             value, grad = log_marginal_likelihood(theta, Xs, ys)
             if extra is not None:
                 v, g = extra(theta)
                 value, grad = value + v, grad + g
-            return (1e25, np.zeros_like(t)) if not np.isfinite(value) else (-value, -grad[free])
+            return value, grad[free]
 
-        best = min((minimize(objective, np.clip(s[free], bounds[free, 0], bounds[free, 1]), jac=True,
-                             method="L-BFGS-B", bounds=bounds[free]) for s in starts), key=lambda r: r.fun)
-        self.log_marginal_likelihood_ = float(-best.fun)
-        return best.x if fixed_noise is None else np.append(best.x, fixed_noise)
+        best = self._maximize(value_and_gradient, bounds[free], [s[free] for s in starts])
+        return best if fixed_noise is None else np.append(best, fixed_noise)
 
 
 class LooNoiseGP(JointReplicateGP):

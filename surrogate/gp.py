@@ -113,11 +113,14 @@ class GaussianProcess:
         return starts
 
     def _optimize(self, Xs, ys):
-        bounds = self._bounds(Xs.shape[1])
-        starts = self._starts(Xs.shape[1], len(ys))
+        return self._maximize(lambda theta: log_marginal_likelihood(theta, Xs, ys), self._bounds(Xs.shape[1]),
+                              self._starts(Xs.shape[1], len(ys)))
 
+    def _maximize(self, value_and_gradient, bounds, starts):
+        """The best of L-BFGS-B runs from each start within ``bounds`` of ``value_and_gradient(theta)
+        -> (value, gradient)``; sets ``log_marginal_likelihood_`` to that value, returns its theta."""
         def objective(theta):
-            value, grad = log_marginal_likelihood(theta, Xs, ys)
+            value, grad = value_and_gradient(theta)
             return (1e25, np.zeros_like(theta)) if not np.isfinite(value) else (-value, -grad)
 
         best = None
