@@ -27,11 +27,11 @@ from colonsim.surrogate.kernel import matern52
 from colonsim.surrogate.likelihood import JITTER, log_marginal_likelihood
 
 # Restarts when none are asked for: a likelihood of a dozen runs has several optima of nearly the
-# same height, and which one a few random starts reach depends on the seed (measured on the
-# 11-run leave-one-out refits of a 12-run RSJ sweep: 2 to 8 random starts missed the best optimum
-# in 6 of 11, by up to 2.4 log units; 32 quasi-random starts found it in all, docs/surrogate.md
-# "Restarts"). Up to SMALL_FIT_RUNS runs a start costs milliseconds (100 runs: 13 ms); above,
-# a start costs up to a second (500 runs) and the likelihood is better determined.
+# same height, and a few starts may stop on a lower one (measured on the 12 leave-one-out refits,
+# 11 runs each, of a 12-run RSJ sweep: 0 / 2 / 8 restarts fell short of the best optimum in 6 / 6
+# / 4 of them, by up to 2.4 log units; 32 and 64 in none; docs/surrogate.md "The model"). Up to
+# SMALL_FIT_RUNS runs a start costs milliseconds (100 runs: 13 ms); above, up to a second (500
+# runs), and the likelihood of that many runs is better determined.
 SMALL_FIT_RUNS = 100
 SMALL_FIT_RESTARTS = 32
 LARGE_FIT_RESTARTS = 2
