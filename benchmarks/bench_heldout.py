@@ -79,16 +79,19 @@ def print_score(label, s):
           f"{'PASS' if all(ok.values()) else 'MISS'}")
 
 
-def heldout(train_folders, test_folder, replicates_folder, sizes, restarts=2, figure=None, targets=TARGETS):
+def replicate_pool(train, replicates, inputs=("scope_diameter_mm", "diameter_mm", "friction")):
+    """The replicate runs with the training runs they repeat: a training subset that lacks the
+    originals still finds the pairs."""
+    originals = train.merge(replicates[list(inputs)].drop_duplicates(), on=list(inputs))
+    return pd.concat([replicates, originals], ignore_index=True)
+
+
+def heldout(train_folders, test_folder, replicates_folder, sizes, restarts=None, figure=None, targets=TARGETS):
     """Print the held-out scores; returns the scores of the model with the floor (for the figure)."""
     folders = [table_of(f) for f in train_folders]
     train = pd.concat(folders, ignore_index=True)
     test = table_of(test_folder)
-    replicates = None if replicates_folder is None else table_of(replicates_folder)
-    if replicates is not None:  # with the training runs they repeat: a subset that lacks them still has the pairs
-        inputs = ["scope_diameter_mm", "diameter_mm", "friction"]
-        originals = train.merge(replicates[inputs].drop_duplicates(), on=inputs)
-        replicates = pd.concat([replicates, originals], ignore_index=True)
+    replicates = None if replicates_folder is None else replicate_pool(train, table_of(replicates_folder))
     print(f"\nheld-out calibration: training runs from {', '.join(map(str, train_folders))} ({len(train)}), "
           f"held out {test_folder} ({len(test)}), replicates {replicates_folder} "
           f"({0 if replicates is None else len(replicates)} runs with the originals); '!' = outside the acceptance band")

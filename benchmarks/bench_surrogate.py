@@ -225,7 +225,7 @@ def main():
     parser.add_argument("--sizes", type=int, nargs="*", default=[40, 150, 500], help="runs of the synthetic tables")
     parser.add_argument("--results", type=Path, help="a sweep's results.parquet / .csv, or its folder")
     parser.add_argument("--target", default="final_deformation_cm", help="output compared (part 1)")
-    parser.add_argument("--restarts", type=int, default=2, help="optimizer restarts per GP (the CLI default, 2)")
+    parser.add_argument("--restarts", type=int, default=2, help="optimizer restarts per GP in parts 1 and 2")
     parser.add_argument("--queries", type=int, default=10_000)
     parser.add_argument("--model-runs", type=int, default=500, help="runs of part 2's table; 0 skips part 2")
     parser.add_argument("--heldout", type=Path, nargs="+", help="part 3: training sweep folders (RSJ, in order)")
@@ -237,7 +237,8 @@ def main():
     if args.heldout:
         if args.test is None:
             parser.error("--heldout needs --test")
-        models = heldout(args.heldout, args.test, args.replicates, args.train_sizes, args.restarts, args.figure)
+        # part 3 fits as `colonsim surrogate fit` does, with the surrogate's own number of restarts
+        models = heldout(args.heldout, args.test, args.replicates, args.train_sizes, None, args.figure)
         query_speed(models[max(models, key=lambda key: key[0])])
 
     # an optimum at a bound is normal here (a length scale of 100 = the output ignores that input)

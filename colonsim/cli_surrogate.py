@@ -73,7 +73,8 @@ def add_parsers(sub):
     fit.add_argument("--targets", nargs="+", help="output columns to model (default: deformations, A, C, forces, stretch)")
     fit.add_argument("--segments", nargs="+", help="segments to fit (default: all in the table)")
     fit.add_argument("--cv", type=_cv, default="loo", help="'loo' (closed-form leave-one-out, default) or k folds")
-    fit.add_argument("--restarts", type=bounded_int(0, 50), default=2, help="extra optimizer starts per GP, 0-50 (default 2)")
+    fit.add_argument("--restarts", type=bounded_int(0, 50),
+                     help="extra optimizer starts per GP, 0-50 (default 32 up to 100 runs, 2 above)")
     fit.add_argument("--min-runs", type=bounded_int(2, 20_000), default=4, help="fewest runs a model is fitted on (default 4)")
     fit.add_argument("--seed", type=seed, default=0, help="seed of the restarts and folds (default 0)")
     fit.add_argument("--material", type=Path, help=MATERIAL_HELP.replace("predictions average", "stored with the "
@@ -156,7 +157,7 @@ def cmd_fit(args):
     from colonsim.surrogate.store import save_surrogate
     from colonsim.surrogate.table import TARGETS, read_results
 
-    if args.restarts < 0 or args.min_runs < 2 or args.threads < 1:
+    if (args.restarts is not None and args.restarts < 0) or args.min_runs < 2 or args.threads < 1:
         raise ColonsimError("--restarts must be >= 0, --min-runs >= 2 and --threads >= 1")
     tissue = _tissue(args)
     table = read_results(args.results)

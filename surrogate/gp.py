@@ -4,8 +4,9 @@ Kernel ``ConstantKernel * Matern(nu=2.5, length_scale=[one per input]) + WhiteKe
 trend whose per-input length scales say how strongly each input matters (a length scale far above
 1 = the output barely depends on that input), plus white noise for the run-to-run scatter of the
 simulations. Inputs are scaled to [0, 1] over ``input_range`` (default: the training data), the
-target is standardized. Hyperparameters maximize the log marginal likelihood (L-BFGS-B with
-restarts); prediction is numpy from the stored Cholesky factor.
+target is standardized. Hyperparameters maximize the log marginal likelihood (L-BFGS-B from a
+default start and quasi-random restarts, :func:`restarts_for`); prediction is numpy from the
+stored Cholesky factor.
 
 Hand-written rather than scikit-learn's ``GaussianProcessRegressor`` configured as the same model,
 because it is faster at the same likelihood: the fit with hyperparameter optimisation 1.7-4x
@@ -19,10 +20,29 @@ from __future__ import annotations
 import numpy as np
 from scipy.linalg import cho_solve, cholesky, solve_triangular
 from scipy.optimize import minimize
+from scipy.stats import qmc
 
 from colonsim.errors import ColonsimError
 from colonsim.surrogate.kernel import matern52
 from colonsim.surrogate.likelihood import JITTER, log_marginal_likelihood
+
+# Restarts when none are asked for: a likelihood of a dozen runs has several optima of nearly the
+# same height, and a few starts may stop on a lower one (measured on the 12 leave-one-out refits,
+# 11 runs each, of a 12-run RSJ sweep: 0 / 2 / 8 restarts fell short of the best optimum in 6 / 6
+# / 4 of them, by up to 2.4 log units; 32 and 64 in none; docs/surrogate.md "The model"). Up to
+# SMALL_FIT_RUNS runs a start costs milliseconds (100 runs: 13 ms); above, up to a second (500
+# runs), and the likelihood of that many runs is better determined.
+SMALL_FIT_RUNS = 100
+SMALL_FIT_RESTARTS = 32
+LARGE_FIT_RESTARTS = 2
+
+
+def restarts_for(n_runs, n_restarts=None) -> int:
+    """Optimizer restarts of a fit on ``n_runs`` runs: ``n_restarts`` if given, else
+    :data:`SMALL_FIT_RESTARTS` up to :data:`SMALL_FIT_RUNS` runs and :data:`LARGE_FIT_RESTARTS` above."""
+    if n_restarts is not None:
+        return int(n_restarts)
+    return SMALL_FIT_RESTARTS if n_runs <= SMALL_FIT_RUNS else LARGE_FIT_RESTARTS
 
 
 class GaussianProcess:
@@ -35,10 +55,11 @@ class GaussianProcess:
     constant_bounds, length_scale_bounds, noise_bounds : (float, float)
         Bounds of the signal variance, of the length scales (in scaled inputs, so 1 = the
         training range) and of the noise variance (both variances in units of the target's variance).
-    n_restarts : int
-        Optimizer runs from random log-uniform starting points, besides the default start.
+    n_restarts : int or None
+        Optimizer runs from quasi-random (scrambled Sobol) log-uniform starting points, besides the
+        default start; None: :func:`restarts_for` the number of runs.
     random_state : int
-        Seed of the restarts.
+        Seed of the scrambling of the restarts.
     noise_floor_sd : float
         Smallest standard deviation of the run-to-run scatter, target units (0: none). The
         lower bound of the noise variance becomes at least its square (the scatter measured by
@@ -46,7 +67,7 @@ class GaussianProcess:
     """
 
     def __init__(self, input_range=None, constant_bounds=(1e-2, 1e2), length_scale_bounds=(1e-2, 1e2),
-                 noise_bounds=(1e-6, 1.0), n_restarts=2, random_state=0, noise_floor_sd=0.0):
+                 noise_bounds=(1e-6, 1.0), n_restarts=None, random_state=0, noise_floor_sd=0.0):
         self.input_range = input_range
         self.noise_floor_sd = noise_floor_sd
         self.constant_bounds = constant_bounds
@@ -78,18 +99,28 @@ class GaussianProcess:
         noise = (max(low, floor), max(high, floor))
         return np.log([self.constant_bounds] + [self.length_scale_bounds] * d + [noise])
 
-    def _optimize(self, Xs, ys):
-        d = Xs.shape[1]
-        bounds = self._bounds(d)
+    def _starts(self, d, n_runs):
+        """Starting points (log hyperparameters) of the optimizer: the default and the restarts."""
         starts = [np.log([1.0] + [0.5] * d + [1e-2])]
         # restarts log-uniform over plausible values, not the whole box: a start with length
-        # scales of 0.01 (white noise) costs many iterations and never wins
-        rng = np.random.default_rng(self.random_state)
-        low, high = np.log([0.1] + [0.1] * d + [1e-4]), np.log([10.0] + [10.0] * d + [0.1])
-        starts += [rng.uniform(low, high) for _ in range(self.n_restarts)]
+        # scales of 0.01 (white noise) costs many iterations and never wins. Sobol points fill
+        # that box evenly, where random ones leave gaps and clumps
+        n_restarts = restarts_for(n_runs, self.n_restarts)
+        if n_restarts:
+            low, high = np.log([0.1] + [0.1] * d + [1e-4]), np.log([10.0] + [10.0] * d + [0.1])
+            sobol = qmc.Sobol(d + 2, seed=self.random_state).random_base2(int(np.ceil(np.log2(n_restarts))))
+            starts += list(low + (high - low) * sobol[:n_restarts])
+        return starts
 
+    def _optimize(self, Xs, ys):
+        return self._maximize(lambda theta: log_marginal_likelihood(theta, Xs, ys), self._bounds(Xs.shape[1]),
+                              self._starts(Xs.shape[1], len(ys)))
+
+    def _maximize(self, value_and_gradient, bounds, starts):
+        """The best of L-BFGS-B runs from each start within ``bounds`` of ``value_and_gradient(theta)
+        -> (value, gradient)``; sets ``log_marginal_likelihood_`` to that value, returns its theta."""
         def objective(theta):
-            value, grad = log_marginal_likelihood(theta, Xs, ys)
+            value, grad = value_and_gradient(theta)
             return (1e25, np.zeros_like(theta)) if not np.isfinite(value) else (-value, -grad)
 
         best = None

@@ -42,8 +42,9 @@ class SweepSurrogate:
         Segments to fit (default: all in the table).
     cv : "loo" or int
         Cross-validation scheme run at fit time (see :mod:`colonsim.surrogate.validation`).
-    n_restarts : int
-        Extra optimizer starts of each GP's hyperparameters.
+    n_restarts : int or None
+        Extra optimizer starts of each GP's hyperparameters; None: as many as the runs call for
+        (:func:`colonsim.surrogate.gp.restarts_for`).
     min_runs : int
         Fewer successful runs with a value than this: no model for that segment and target.
     random_state : int
@@ -60,7 +61,7 @@ class SweepSurrogate:
         ``scatter_``). None: no floor.
     """
 
-    def __init__(self, targets=TARGETS, inputs=INPUTS, segments=None, cv="loo", n_restarts=2, min_runs=4,
+    def __init__(self, targets=TARGETS, inputs=INPUTS, segments=None, cv="loo", n_restarts=None, min_runs=4,
                  random_state=0, threads=1, tissue=None, replicates=None):
         self.targets = targets
         self.inputs = inputs

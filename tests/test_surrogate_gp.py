@@ -9,7 +9,7 @@ import pytest
 from sklearn.gaussian_process import GaussianProcessRegressor
 from sklearn.gaussian_process.kernels import ConstantKernel, Matern, WhiteKernel
 
-from colonsim.surrogate.gp import GaussianProcess
+from colonsim.surrogate.gp import SMALL_FIT_RUNS, GaussianProcess, restarts_for
 from colonsim.surrogate.likelihood import log_marginal_likelihood
 from colonsim.surrogate.validation import Z95, cross_validate, loo_predictions
 
@@ -103,3 +103,24 @@ def test_cross_validation_is_sensible(fitted, data):
     assert loo["rmse"] < 0.05 and loo["max_abs_error"] < 0.15 and loo["q2"] > 0.99
     kfold = cross_validate(fitted, X, y, 5, make_gp=lambda: GaussianProcess(n_restarts=0))
     assert kfold["scheme"].startswith("5-fold") and kfold["rmse"] < 0.06 and kfold["coverage_95"] >= 0.8
+
+
+@pytest.mark.parametrize("seed", [0, 13])
+def test_default_restarts_find_the_best_optimum_of_few_runs(seed):
+    """Eleven noisy runs: a likelihood with several optima, where 2 restarts stop on a lower one and
+    the default for small sweeps (32) reaches what 64 reach."""
+    rng = np.random.default_rng(seed)
+    X = rng.random((11, 3))
+    y = smooth(X) + rng.normal(0.0, 0.05, len(X))
+
+    def best(n_restarts):
+        return GaussianProcess(input_range=(np.zeros(3), np.ones(3)), n_restarts=n_restarts).fit(X, y).log_marginal_likelihood_
+
+    default = best(None)
+    assert default >= best(64) - 1e-6
+    assert best(2) < default - 0.5
+
+
+def test_restarts_follow_the_size_of_the_sweep():
+    assert restarts_for(SMALL_FIT_RUNS) == 32 and restarts_for(SMALL_FIT_RUNS + 1) == 2
+    assert restarts_for(12, n_restarts=0) == 0 and restarts_for(500, n_restarts=7) == 7
