@@ -9,7 +9,9 @@ changes at half the speed (%), the steps and the wall time of a run. Writes the 
 (``--out``).
 
 Run: ``python benchmarks/bench_quasi_static.py [--cases rsj thf] [--configs default lateral_60 ...]
-[--workers 2] [--out bench_quasi_static.csv]``.
+[--workers 2] [--out bench_quasi_static.csv]``. The resisted RSF cases (``rsf_10N``, without and
+with friction; ``--configs default lateral_50``) measure the settled end and the lateral damping's
+delay of buckling (docs/model.md, "Distal resistance").
 """
 
 from __future__ import annotations
@@ -24,12 +26,17 @@ import pandas as pd
 CASES = {
     "rsj": {"segment": "rsj", "scope": "13.3", "diameter_mm": 36.0},
     "thf": {"segment": "thf", "scope": "13.3", "angle_deg": 45.0},
+    # the resisted RSF whose settled end the push speed moved (docs/model.md, "Every run ends at rest")
+    "rsf_10N": {"segment": "rsf", "scope": "13.3", "angle_deg": 45.0, "distal_resistance_N": 10.0},
+    "rsf_10N_mu01": {"segment": "rsf", "scope": "13.3", "angle_deg": 45.0, "distal_resistance_N": 10.0,
+                     "friction": 0.1},
 }
 # each configuration: the InsertionCase fields it changes from the defaults (None: no lip)
 CONFIGS = {
     "default": {},
     "no_lip": {"sheath_lip": False},
     "lateral_60_colon_60": {"scope_lateral_damping": 60.0, "colon_damping": 60.0},
+    "lateral_50": {"scope_lateral_damping": 50.0},
     "axial_1e-3": {"scope_axial_damping_s": 1e-3},
     "axial_1e-2": {"scope_axial_damping_s": 1e-2},
     "axial_0": {"scope_axial_damping_s": 0.0},
@@ -106,7 +113,7 @@ def change(a, b, name):
 
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--cases", nargs="+", default=list(CASES), choices=list(CASES))
+    parser.add_argument("--cases", nargs="+", default=["rsj", "thf"], choices=list(CASES))
     parser.add_argument("--configs", nargs="+", default=list(CONFIGS), choices=list(CONFIGS))
     parser.add_argument("--workers", type=int, default=2)
     parser.add_argument("--out", default="bench_quasi_static.csv")
