@@ -166,13 +166,14 @@ def _case(record) -> InsertionCase:
     return case
 
 
-def fit_round(table, target, seed):
+def fit_round(table, target, seed, n_restarts=None):
     """The surrogate of the sweep's successful runs (read in key order) and, per segment, the
-    leave-one-out metrics of ``target`` (or why there is no model)."""
+    leave-one-out metrics of ``target`` (or why there is no model). ``n_restarts``: the GP
+    optimizer's restarts (None: :func:`colonsim.surrogate.gp.restarts_for` the number of runs)."""
     from colonsim.surrogate.model import SweepSurrogate
 
     table = table.sort_values("key").reset_index(drop=True)
-    model = SweepSurrogate(targets=[target], cv="loo", random_state=seed).fit(table)
+    model = SweepSurrogate(targets=[target], cv="loo", random_state=seed, n_restarts=n_restarts).fit(table)
     cv = {}
     for segment in model.domains_:
         metrics = model.cv_[segment].get(target)
