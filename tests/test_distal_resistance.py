@@ -35,23 +35,25 @@ def test_plain_coulomb_sticks_then_slips():
     assert regularised_force(0.2, 0.01, 5.0, 0.0) == -5.0  # slipping: the full resistance
 
 
-def _pushed_rod(resistances=()):
+def _pushed_rod(resistances=(), velocity=(0.3, 0.0, 0.0)):
+    """A rod pushed out of its sheath for 0.05 s against tip resistances of the given forces (N,
+    creep speed 3 mm/s): the solver, the drive and the resistances."""
     rod = Rod.straight(0.3, 12.8e-3, 16e6, 2944.0, spacing=5e-3, damping_time=3e-3, lateral_damping=200.0)
-    drive = PrescribedVelocity(rod, [0], (0.3, 0.0, 0.0), ramp=0.02)
+    drive = PrescribedVelocity(rod, [0], velocity, ramp=0.02)
     sheath = LineConstraint(rod, (0.0, 0.0, 0.0), (1.0, 0.0, 0.0), extent=(-math.inf, 0.1))
     resisted = [TipResistance(rod, rod.tip_node, (1.0, 0.0, 0.0), force, creep_speed=3e-3)
                 for force in resistances]
     sim = ExplicitSolver([rod], constraints=[drive, sheath], resistances=resisted)
     sim.run(0.05, record_interval=1e-3)
-    return sim, drive
+    return sim, drive, resisted
 
 
 def test_zero_resistance_changes_nothing_bit_for_bit():
-    free, _ = _pushed_rod()
-    zero, _ = _pushed_rod([0.0])
+    free, _, _ = _pushed_rod()
+    zero, _, _ = _pushed_rod([0.0])
     assert np.array_equal(free.state["scope"].x, zero.state["scope"].x)
     assert np.array_equal(free.state["scope"].v, zero.state["scope"].v)
-    held, drive = _pushed_rod([2.0])
+    held, drive, _ = _pushed_rod([2.0])
     assert not np.array_equal(free.state["scope"].x, held.state["scope"].x)
     assert drive.reaction[0] == pytest.approx(2.0, rel=0.05)  # the push now carries the resistance
 
@@ -59,12 +61,7 @@ def test_zero_resistance_changes_nothing_bit_for_bit():
 def _held_after_push(creep_speed_at_rest, waits=6):
     """A rod pushed against a 2 N tip resistance, its drive then stopped: the resisted force after
     each 0.05 s of waiting at rest, with the resistance's creep speed at rest as given."""
-    rod = Rod.straight(0.3, 12.8e-3, 16e6, 2944.0, spacing=5e-3, damping_time=3e-3, lateral_damping=200.0)
-    drive = PrescribedVelocity(rod, [0], lambda t: np.array([0.3 if t < 0.05 else 0.0, 0.0, 0.0]), ramp=0.02)
-    sheath = LineConstraint(rod, (0.0, 0.0, 0.0), (1.0, 0.0, 0.0), extent=(-math.inf, 0.1))
-    tip = TipResistance(rod, rod.tip_node, (1.0, 0.0, 0.0), 2.0, creep_speed=3e-3)
-    sim = ExplicitSolver([rod], constraints=[drive, sheath], resistances=[tip])
-    sim.run(0.05, record_interval=1e-3)
+    sim, _, (tip,) = _pushed_rod([2.0], velocity=lambda t: np.array([0.3 if t < 0.05 else 0.0, 0.0, 0.0]))
     tip.creep_speed = creep_speed_at_rest
     forces = []
     for _ in range(waits):

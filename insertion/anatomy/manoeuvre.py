@@ -66,7 +66,7 @@ class PushProfile:
         self._levels = []
         previous = 0.0
         for p in self.phases:
-            self._levels.append((p.start, p.speed - previous, self.ramp if p.ramp is None else p.ramp))
+            self._levels.append((p.start, p.speed - previous, self.ramp_of(p)))
             previous = p.speed
 
     @property
@@ -87,13 +87,15 @@ class PushProfile:
         last = self.phases[-1]
         return last.start if last.name == SETTLE else None
 
+    def ramp_of(self, phase):
+        """The speed ramp into ``phase``, s (the profile's own unless the phase sets one)."""
+        return self.ramp if phase.ramp is None else phase.ramp
+
     @property
     def hold_start(self):
         """Time the push has come to rest and the closing hold begins, s (None: no settle phase)."""
-        last = self.phases[-1]
-        if last.name != SETTLE:
-            return None
-        return last.start + (self.ramp if last.ramp is None else last.ramp)
+        start = self.settle_start
+        return None if start is None else start + self.ramp_of(self.phases[-1])
 
     def stop(self, t, distance, hold):
         """End the push from time ``t``: slow to rest over ``distance`` (m) of push and hold still
