@@ -357,7 +357,9 @@ COLUMNS = {c.name: c for c in (
     Column("ramp_s", _S, "s", "speed-change ramp"),
     Column("relax_s", _S, "s", "relax pause of straighten-relax-push"),
     Column("stop_distance_mm", _S, "mm", "push over which the scope slows to rest at the end of the run (0: at once)"),
-    Column("settle_s", _S, "s", "time the scope is held still at the end before the final values are read"),
+    Column("settle_s", _S, "s", "shortest time the scope is held still at the end before the final values are read"),
+    Column("settle_max_s", _S, "s", "longest hold at the end: the final values are read once the run has come to rest "
+                                    "(docs/model.md, \"Loading\") or after this"),
     Column("settle_lateral_damping", _S, "1/s", "lateral damping of the scope while it settles at rest"),
     Column("exit_length_mm", _S, "mm", "fixed colon after the last mobile piece (a minimum where the exit takes the "
                                        "whole available length: RSF, THF, fixed THF)"),
@@ -393,6 +395,8 @@ COLUMNS = {c.name: c for c in (
     Column("quasi_static", _O, "", "the ringing ratio is below 0.1: the push force follows the push without ringing"),
     Column("kinetic_energy_check", _O, "", "kinetic / internal energy below 10 % on most samples for both bodies, the "
                                            "scope's imposed sliding set aside (information: it passed runs that rang)"),
+    Column("came_to_rest", _O, "", "the run came to rest in its closing hold before the final values were read: the "
+                                   "deformation and the tip still within 0.02 mm over 0.05 s (docs/model.md, \"Loading\")"),
     Column("max_lag_cm", _O, "cm", "largest lag of the scope: pushed depth minus the tip's advance along the "
                                    "centerline (a proxy of the buckled length)", TARGET, "maximum scope lag [cm]"),
     Column("final_lag_cm", _O, "cm", "the scope's lag at the end of the run", TARGET, "final scope lag [cm]"),

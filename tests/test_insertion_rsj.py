@@ -88,5 +88,6 @@ def test_runs_are_held_back_in_the_exit_and_stay_quasi_static(rsj_runs):
         assert s["distal_resistance"]["acting"] and s["distal_resistance"]["max_force_N"] > 0.0
         assert s["quasi_static"]["energy"]["fraction_below_10pct"]["colon"] > 0.5
         assert s["quasi_static"]["holds"], s["quasi_static"]
+        assert s["at_rest"]["came_to_rest"], s["at_rest"]
         assert r.timeseries.notna().all().all()
         assert 1.0 < s["max_wall_stretch"] < 2.0

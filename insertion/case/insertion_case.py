@@ -76,10 +76,15 @@ class InsertionCase:
         Scope length that stays in the sheath at the end of the push (**assumption** 20).
     ramp_s, relax_s : float
         Speed-change ramp and the relax pause of RSF/THF, s.
-    stop_distance_mm, settle_s : float
+    stop_distance_mm, settle_s, settle_max_s : float
         The push ends at rest: it slows to a stop over ``stop_distance_mm`` of push (default 0:
         at once), every node is then stopped where it is (its kinetic energy removed) and the scope
-        is held still for ``settle_s``; the final values are read then (docs/model.md, "Loading").
+        is held still for at least ``settle_s`` and until it has come to rest (the criterion of
+        :func:`colonsim.insertion.case.outcomes.rest_drift`), at most ``settle_max_s``; the final
+        values are read then, and the summary says whether it came to rest (docs/model.md, "Loading").
+    settle_lateral_damping : float
+        Lateral damping of the scope while it settles, 1/s (20: near critical for the slowest
+        bending modes of a loop, so it comes to rest in tenths of a second).
     colon_damping, scope_damping : float
         Mass-proportional damping, 1/s (the scope's drags its push: 0 by default).
     scope_lateral_damping : float
@@ -114,7 +119,8 @@ class InsertionCase:
     relax_s: float = 0.1
     stop_distance_mm: float = 0.0
     settle_s: float = 0.1
-    settle_lateral_damping: float = 200.0
+    settle_max_s: float = 1.0
+    settle_lateral_damping: float = 20.0
     exit_length_mm: float = 100.0
     distal_resistance_N: float = 5.0
     failure_stretch: float = 1.6
@@ -147,7 +153,9 @@ class InsertionCase:
             ("scope_lateral_damping", self.scope_lateral_damping, 0.0, 1e4, "damping in 1/s"),
             ("scope_axial_damping_s", self.scope_axial_damping_s, 0.0, 0.1, "Kelvin-Voigt damping time in s (3e-3)"),
             ("stop_distance_mm", self.stop_distance_mm, 0.0, 100.0, "push distance to slow to rest, mm (0)"),
-            ("settle_s", self.settle_s, 0.0, 10.0, "settling time at rest at the end, s (0.1)"),
+            ("settle_s", self.settle_s, 0.0, 10.0, "shortest hold at rest at the end, s (0.1)"),
+            ("settle_max_s", self.settle_max_s, self.settle_s, 10.0,
+             "longest hold at rest at the end, s, at least settle_s (1.0)"),
             ("settle_lateral_damping", self.settle_lateral_damping, 0.0, 1e4, "damping in 1/s"),
             ("record_interval_s", self.record_interval_s, 1e-6, 1.0, "recording interval in s"),
             ("time_step_factor", self.time_step_factor, 0.01, 1.0, "a safety factor in (0, 1]"),

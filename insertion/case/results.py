@@ -20,7 +20,7 @@ import pandas as pd
 from matplotlib.figure import Figure
 
 from colonsim.files import atomic_path, save_figure, write_csv, write_json
-from colonsim.insertion.case.outcomes import RINGING_LIMIT
+from colonsim.insertion.case.outcomes import REST_WINDOW, RINGING_LIMIT
 
 
 def user_units(ts: pd.DataFrame) -> pd.DataFrame:
@@ -48,6 +48,18 @@ def quasi_static_words(qs: dict) -> str:
     return f"ringing ratio {ratio:.3f} (limit {RINGING_LIMIT:g}): quasi-static {verdict}"
 
 
+def rest_words(rest: dict) -> str:
+    """Whether the run came to rest before its final values were read (a summary's ``at_rest``),
+    for the command line."""
+    if rest["deformation_drift_mm"] is None:
+        return f"final values read without coming to rest ({rest['meaning']})"
+    if rest["came_to_rest"]:
+        return f"came to rest {rest['held_s']:.2f} s after the push stopped"
+    return (f"did NOT come to rest in {rest['held_s']:.2f} s: the deformation moved {rest['deformation_drift_mm']:.3f} mm "
+            f"and the tip {rest['tip_drift_mm']:.3f} mm over the last {REST_WINDOW:g} s, so the final values are not "
+            "settled (raise settle_max_s)")
+
+
 def distal_words(summary: dict) -> str:
     """The distal resistance and the scope's lag of a summary, for the command line."""
     d = summary["distal_resistance"]
@@ -72,6 +84,7 @@ def comparison_table(results) -> pd.DataFrame:
                            "max_lag_cm": r.summary["max_lag_cm"], "final_lag_cm": r.summary["final_lag_cm"],
                            "ringing_ratio": r.summary["quasi_static"]["ringing_ratio"],
                            "quasi_static": r.summary["quasi_static"]["holds"],
+                           "came_to_rest": r.summary["at_rest"]["came_to_rest"],
                            "ended_by": r.summary["ended_by"], "wall_time_s": r.summary["wall_time_s"]}
                           for r in results])
 

@@ -6,8 +6,9 @@ from __future__ import annotations
 
 from colonsim.catalog import colon_model
 from colonsim.insertion.anatomy.manoeuvre import SETTLE
-from colonsim.insertion.case.outcomes import (JAM_PROGRESS, JAM_PUSH, PEAK_WINDOW, RINGING_LIMIT, RINGING_WINDOW,
-                                              characteristic_points, peak_trend, quasi_static_fraction, ringing_ratio)
+from colonsim.insertion.case.outcomes import (JAM_PROGRESS, JAM_PUSH, PEAK_WINDOW, REST_TOLERANCE, REST_WINDOW,
+                                              RINGING_LIMIT, RINGING_WINDOW, characteristic_points, peak_trend,
+                                              quasi_static_fraction, rest_drift, ringing_ratio)
 from colonsim.insertion.engine.material import REFERENCE_MATERIAL_PATH
 from colonsim.provenance import code_version
 
@@ -65,6 +66,25 @@ def quasi_static_summary(ts, energy_fractions, sliding) -> dict:
     }
 
 
+def rest_summary(ts, hold_start) -> dict:
+    """Whether the run came to rest in its closing hold before its final values were read
+    (docs/model.md, "Loading"): ``came_to_rest``, the time held, and how far the colon deformation
+    and the tip moved over the hold's last :data:`REST_WINDOW` (mm)."""
+    out = {"criterion": f"the colon deformation and the tip each move less than {REST_TOLERANCE * 1e3:g} mm over the "
+                        f"last {REST_WINDOW:g} s of the closing hold",
+           "came_to_rest": False, "held_s": 0.0, "deformation_drift_mm": None, "tip_drift_mm": None}
+    if hold_start is None or ts["time_s"].iloc[-1] < hold_start:
+        return {**out, "meaning": "no closing hold: the run ended under its load (a jam or a tear) or without one"}
+    hold = ts[ts["time_s"] >= hold_start - 1e-12]
+    out["held_s"] = float(ts["time_s"].iloc[-1] - hold_start)
+    drift = rest_drift(hold["time_s"], hold["deformation_m"], hold["tip_displacement_m"])
+    if drift is None:
+        return {**out, "meaning": f"held for less than {REST_WINDOW:g} s: too short to tell"}
+    out.update(deformation_drift_mm=drift[0] * 1e3, tip_drift_mm=drift[1] * 1e3,
+               came_to_rest=bool(max(drift) < REST_TOLERANCE))
+    return out
+
+
 def summarize(model, ts, wall_s, build_s) -> dict:
     """The summary of one run: deformation, points A/B/C, forces, energy check, sizes, inputs."""
     points = characteristic_points(ts["time_s"], ts["depth_m"], ts["deformation_m"])
@@ -99,6 +119,7 @@ def summarize(model, ts, wall_s, build_s) -> dict:
                               "final_force_N": float(ts["distal_force_N"].iloc[-1]),
                               "max_force_N": float(ts["distal_force_N"].max())},
         "quasi_static": quasi_static_summary(ts, qs, sliding),
+        "at_rest": rest_summary(ts, model.push.hold_start),
         "simulated_time_s": float(ts["time_s"].iloc[-1]),
         "steps": int(model.solver.step),
         "time_step_s": {"min": float(ts["dt_s"].min()), "max": float(ts["dt_s"].max())},

@@ -47,6 +47,7 @@ from colonsim.insertion.anatomy.manoeuvre import SETTLE, PushProfile, continuous
 from colonsim.insertion.anatomy.scopes import colonoscope
 from colonsim.insertion.case.case_material import case_material
 from colonsim.insertion.case.insertion_case import InsertionCase
+from colonsim.insertion.case.outcomes import REST_TOLERANCE, REST_WINDOW, rest_drift
 from colonsim.insertion.case.recording import InsertionRecorder
 from colonsim.insertion.case.run_summary import end_state, summarize, tip_passed_end
 from colonsim.insertion.engine.constraints import FixedNodes, LineConstraint, PrescribedVelocity
@@ -128,7 +129,7 @@ def build_insertion(case: InsertionCase) -> Insertion:
     rod = scope.rod(start=entry - length * axis, direction=axis, length=length,
                     spacing=case.scope_spacing_mm * 1e-3, damping_time=case.scope_axial_damping_s,
                     lateral_damping=case.scope_lateral_damping)
-    stop = (case.stop_distance_mm * 1e-3, case.settle_s)
+    stop = (case.stop_distance_mm * 1e-3, case.settle_max_s)
     if anatomy.manoeuvre == CONTINUOUS_PUSH:
         push = continuous_push(total_depth, case.push_speed, case.ramp_s, *stop)
     else:
@@ -216,6 +217,18 @@ def bring_to_rest(model):
         state.v[:] = 0.0
 
 
+def came_to_rest(rows) -> bool:
+    """Have the recorded samples ``rows`` (the recorder's dicts) been still over the last
+    :data:`~colonsim.insertion.case.outcomes.REST_WINDOW`? (the criterion of :func:`rest_drift`)"""
+    k = len(rows) - 1
+    while k > 0 and rows[k]["time_s"] > rows[-1]["time_s"] - REST_WINDOW:
+        k -= 1  # back to the first sample at or before the window's start
+    tail = rows[k:]
+    drift = rest_drift([r["time_s"] for r in tail], [r["deformation_m"] for r in tail],
+                       [r["tip_displacement_m"] for r in tail])
+    return drift is not None and max(drift) < REST_TOLERANCE
+
+
 CHUNK_PUSH = 1e-3  # m: the end rules are checked after every millimetre of push (at most every 10 ms)
 
 
@@ -260,6 +273,8 @@ def run_insertion(case: InsertionCase, progress=None, snapshot_interval=None) ->
             held = share > 0.0
             model.resistance.engage(share, lumen_direction(model.geometry, last["tip_arc_m"]) if held else None)
         if ended_by is not None:
+            if at_rest and model.solver.time >= push.hold_start + case.settle_s - 1e-12 and came_to_rest(recorder.rows):
+                break
             continue
         if last["max_stretch"] > case.failure_stretch:
             ended_by = "wall_stretch"
@@ -273,7 +288,7 @@ def run_insertion(case: InsertionCase, progress=None, snapshot_interval=None) ->
             continue
         if ended_by in ("jam", "wall_stretch") or push.settle_start is None:
             break  # a jam or a tear ends where it happened, under its load; a profile without a settle phase, at its rule
-        push.stop(model.solver.time, case.stop_distance_mm * 1e-3, case.settle_s)
+        push.stop(model.solver.time, case.stop_distance_mm * 1e-3, case.settle_max_s)
     ended_by = ended_by or "length_used"
     wall = time.perf_counter() - t0
     frame = recorder.frame()

@@ -52,6 +52,7 @@ def _outputs(summary) -> dict:
     out["ringing_ratio"] = number(qs.get("ringing_ratio"))
     out["quasi_static"] = bool(qs.get("holds", False))
     out["kinetic_energy_check"] = bool((qs.get("energy") or {}).get("holds", False))
+    out["came_to_rest"] = bool((summary.get("at_rest") or {}).get("came_to_rest", False))
     end = summary.get("end") or {}
     out["ended_by"] = str(summary.get("ended_by", ""))  # tip_past_end, far_end, length_used, wall_stretch or jam
     for name, key in (("end_depth_cm", "depth_cm"), ("end_push_force_N", "push_force_N"),
