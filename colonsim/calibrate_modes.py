@@ -107,6 +107,8 @@ def _describe(r) -> str:
     for i, (n, unit) in enumerate(zip(law.parameter_names, law.units)):
         shown = "-" if unit == "1" else unit  # Ogden's exponents are dimensionless
         lines.append(f"  {n:>6} = {r.parameters[i]:14.6g} {shown:<2}  sd {sd[i]:.3g}   95% [{ci[i, 0]:.6g}, {ci[i, 1]:.6g}]")
+    if r.uncertainty.unidentified_words():
+        lines.append(f"  {r.uncertainty.unidentified_words()}")
     mu0, mu0_sd = r.mu0
     lines.append(f"  mu0 = {mu0:.6g} Pa, sd {mu0_sd:.3g}")
     for _, row in r.per_curve.iterrows():

@@ -136,6 +136,8 @@ def _format_result(r) -> str:
     lines = [f"{r.curve.name}: {r.model['model']}, law {r.model['law']}"]
     for i, n in enumerate(r.names):
         lines.append(f"  {n:>4} = {r.parameters[i]:12.1f} Pa   sd {unc.std[i]:10.1f}   95% [{ci[i, 0]:.1f}, {ci[i, 1]:.1f}]")
+    if unc.unidentified_words():
+        lines.append(f"  {unc.unidentified_words()}")
     corr = unc.correlation
     pairs = ", ".join(f"{r.names[i]}/{r.names[j]} {corr[i, j]:+.3f}" for i in range(len(r.names)) for j in range(i + 1, len(r.names)))
     if pairs:

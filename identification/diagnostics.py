@@ -81,6 +81,8 @@ def identification_words(mu0, mu0_sd, follows_curve) -> str:
     """How well mu0 is known, in words the numbers support."""
     if not follows_curve:
         return "its sd reflects the noise only and understates the error: the law does not follow the curve"
+    if not np.isfinite(mu0_sd):
+        return "not identified: the data do not fix it (a combination of the parameters it depends on is free)"
     rel = mu0_sd / abs(mu0) if mu0 else float("inf")
     if rel <= WELL_IDENTIFIED:
         quality = "well identified"

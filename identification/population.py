@@ -100,6 +100,7 @@ def population_figure(results) -> Figure:
     for ax, (k, name) in zip(axes[1:], enumerate(names)):
         est = np.array([r.parameters[k] for r in results]) / 1e3
         sd = np.array([r.uncertainty.std[k] for r in results]) / 1e3
+        sd = np.where(np.isfinite(sd), sd, np.nan)  # no bar where the data do not identify the parameter
         ax.errorbar(idx, est, yerr=1.96 * sd, fmt="o", capsize=3)
         ax.axhline(est.mean(), c="tab:red", lw=1, label="population mean")
         ax.set_xticks(idx, [r.curve.name for r in results], rotation=60, fontsize=7)

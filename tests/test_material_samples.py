@@ -82,6 +82,18 @@ def test_a_posterior_mostly_below_zero_is_refused():
         post.draw(10, seed=0)
 
 
+def test_a_calibration_that_leaves_a_combination_free_is_not_sampled(tmp_path):
+    """A posterior unbounded along a direction the data do not fix (identification/uncertainty.py)
+    cannot be drawn from: refused in one line naming the combination."""
+    path = material_file(tmp_path)
+    doc = json.loads(path.read_text())
+    doc["uncertainty"] = {"unidentified": [{"direction_in_bound_widths": {"C10": 0.71, "C01": -0.71, "C11": 0.0}}]}
+    path.write_text(json.dumps(doc))
+    with pytest.raises(ColonsimError, match=r"does not identify \+0.71 C10, -0.71 C01") as err:
+        read_posterior(path)
+    assert "\n" not in str(err.value)
+
+
 def test_seeds_make_draws_reproducible(tmp_path):
     post = read_posterior(material_file(tmp_path))
     assert np.array_equal(post.draw(50, 3), post.draw(50, 3)) and not np.array_equal(post.draw(50, 3), post.draw(50, 4))

@@ -104,6 +104,13 @@ def read_posterior(path) -> Posterior:
         what = "a per-specimen population.json (use population = ...)" if "specimens" in doc else "a file"
         raise ColonsimError(f"{path} is {what} without covariance_Pa2, so there is no posterior to draw from; "
                             "calibrate with colonsim calibrate, which writes covariance_Pa2")
+    free = (doc.get("uncertainty") or {}).get("unidentified") or []
+    if free:
+        combos = "; ".join(", ".join(f"{c:+.2f} {n}" for n, c in d["direction_in_bound_widths"].items() if abs(c) > 1e-3)
+                           for d in free)
+        raise ColonsimError(f"{path}: the calibration does not identify {combos} (in bound widths), so its posterior "
+                            "is unbounded there and cannot be sampled; fix one of those parameters or calibrate on "
+                            "data that load them differently")
     order = list((doc.get("correlation") or {}).get("names") or names)
     try:
         cov = np.array(cov, dtype=float)
