@@ -8,7 +8,9 @@ the solver's stable time step at the start and the push duration, and estimates 
 the wall time; :func:`check_run_budget` refuses a run over a step limit, naming the likely cause.
 
 The estimate is of the start: contact later shortens the step a little (a default RSJ run: 12,600
-steps estimated, 14,800 taken) and a run may end before the push does (the tip passed the end).
+steps estimated, 14,800 taken), a run may end before the push does (the tip passed the end), and
+the closing hold is counted at its shortest (``settle_s``; a run that takes long to come to rest
+holds up to ``settle_max_s``).
 """
 
 from __future__ import annotations
@@ -89,6 +91,8 @@ def estimate_run(case) -> RunBudget:
         raise ColonsimError(f"{case.segment} {case.scope}: no stable time step exists for this model ({dt!r} s); "
                             "check the wall material and mesh")
     duration = float(model.push.duration)
+    if model.push.settle_start is not None:  # the closing hold at its shortest: most runs come to rest early
+        duration -= case.settle_max_s - case.settle_s
     steps = duration / dt
     nodes = sum(len(solver.state[b.name].x) for b in solver.bodies)
     a, b = STEP_COST_S
