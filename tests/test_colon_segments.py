@@ -250,8 +250,41 @@ def test_a_model_whose_tube_cuts_itself_is_refused():
     colon_geometry("rsf", D, 45.0, H, T, exit_length=0.10, flexure_angle_deg=180.0)  # a 10 cm exit fits
 
 
+def test_a_lengthened_exit_that_would_cut_the_tube_folds_out_of_the_plane():
+    """The same 30 cm exit folded after its first 10 cm: a quarter turn of the flexure radius
+    out of the model's plane (+z), so it never comes back across the sigmoid; the exit (where the
+    distal resistance engages) still begins where the flexure ends, and its length is unchanged."""
+    straight = colon_geometry("rsf", D, 45.0, H, T, exit_length=0.10, flexure_angle_deg=180.0)
+    folded = colon_geometry("rsf", D, 45.0, H, T, exit_length=0.30, flexure_angle_deg=180.0, exit_fold_after=0.10)
+    c = folded.tube.centerline
+    assert [(type(p).__name__, p.name) for p in c.pieces[-3:]] == [
+        ("Straight", "transverse"), ("Arc", "transverse"), ("Straight", "transverse")]
+    assert folded.centerline_length == pytest.approx(straight.centerline_length + 0.20, abs=1e-9)
+    assert folded.exit_start == pytest.approx(straight.exit_start, abs=1e-9)
+    assert folded.exit_start == pytest.approx(c.s_start[-3], abs=1e-9)
+    z = c.position(np.array([folded.exit_start + 0.10, c.length]))[:, 2]  # in the plane up to the fold
+    assert z[0] == pytest.approx(0.0, abs=1e-9)
+    assert z[1] == pytest.approx(FLEXURE_RADIUS + (0.20 - 0.5 * np.pi * FLEXURE_RADIUS), abs=1e-6)
+    assert np.allclose(c.tangent(c.length), [0.0, 0.0, 1.0], atol=1e-9)
+    # a 90 deg flexure's exit does not cross the colon: without a fold it stays one straight piece
+    plain = colon_geometry("rsf", D, 45.0, H, T, exit_length=0.30)
+    assert type(plain.tube.centerline.pieces[-1]).__name__ == "Straight" and plain.tube.centerline.pieces[-2].name != "transverse"
+
+
 def _node_arc(centerline, points):
     """Arc length of the centerline point closest to each of ``points`` (sampled every 0.5 mm)."""
     s = np.linspace(0.0, centerline.length, int(centerline.length / 5e-4) + 1)
     p = centerline.position(s)
     return s[np.argmin(((points[:, None, :] - p[None, :, :]) ** 2).sum(axis=2), axis=1)]
+
+
+def test_an_rsf_insertion_with_its_flexure_turned_back_builds():
+    """RSF at alpha 45 deg with the splenic flexure turned by 180 deg: the exit lengthened to take
+    the scope's available length folds out of the plane instead of crossing the sigmoid."""
+    from colonsim.insertion.case.scenario import InsertionCase, build_insertion
+
+    model = build_insertion(InsertionCase(segment="rsf", scope="9.2", angle_deg=45.0, flexure_angle_deg=180.0,
+                                          element_size_mm=6.0))
+    pieces = model.geometry.tube.centerline.pieces
+    assert type(pieces[-2]).__name__ == "Arc" and pieces[-2].name == "transverse"
+    assert model.geometry.exit_start == pytest.approx(rsf_centerline(45.0, flexure_angle_deg=180.0, exit_length=0.0).length)

@@ -73,6 +73,10 @@ class Kink:
     fillet_radius: float | None = None
 
 
+class TubeClash(ColonsimError):
+    """A tube around a centerline would cut itself: two parts of it cross."""
+
+
 def check_length(what, value, upper=MAX_LENGTH):
     if not (np.isfinite(value) and 0.0 < value <= upper):
         raise ColonsimError(f"{what} = {value!r} m must be a positive length up to {upper:g} m; fix it.")
@@ -372,7 +376,7 @@ class Centerline(LabelledCenterline):
         clash = self.first_clash(lambda s: np.full(np.shape(s), float(diameter)))
         if clash is not None:
             s_i, s_j, dist = clash
-            raise ColonsimError(
+            raise TubeClash(
                 f"a {diameter * 1e3:.0f} mm tube cuts itself between {self.name_at(s_i)} and "
                 f"{self.name_at(s_j)} (centerlines {dist * 100:.1f} cm apart); "
                 "use a smaller diameter or a smaller angle."

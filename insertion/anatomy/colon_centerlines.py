@@ -24,6 +24,26 @@ EXIT_LENGTH = 0.10  # m, assumption: the fixed colon every model continues into 
 FLEXURE_ANGLE_DEG = 90.0  # assumption: turn of the splenic and hepatic flexures
 
 
+def exit_pieces(exit_length, name, fold_after=None):
+    """The fixed exit a model continues into: one straight piece of ``exit_length`` m (none at 0).
+
+    With ``fold_after`` (m) shorter than ``exit_length``, the exit runs straight for ``fold_after``,
+    then folds out of the model's plane (towards ``+z``) by a quarter turn of the flexure radius and
+    runs on straight, ``exit_length`` long in all (**assumption**, docs/model.md "Colon models": an
+    exit lengthened to take the scope's whole available length after a flexure turned far enough
+    would run back across the colon it came from; the fixed colon beyond the model leaves its
+    plane instead). Every piece is fixed and carries ``name``."""
+    if exit_length == 0.0:
+        return []
+    if fold_after is None or exit_length <= fold_after:
+        return [Straight(exit_length, "fixed", name)]
+    turn = 0.5 * np.pi * FLEXURE_RADIUS
+    pieces = [Straight(fold_after, "fixed", name), Arc(FLEXURE_RADIUS, 0.5 * np.pi, "fixed", name, roll=0.5 * np.pi)]
+    if exit_length > fold_after + turn:
+        pieces.append(Straight(exit_length - fold_after - turn, "fixed", name))
+    return pieces
+
+
 def rsj_centerline(rectum_length=0.04, sigmoid_radius=FLEXURE_RADIUS, sigmoid_angle_deg=180.0,
                    exit_length=EXIT_LENGTH):
     """Rectosigmoid junction: a straight fixed rectum, the mobile sigmoid as one arc, a fixed exit.
@@ -53,7 +73,7 @@ def rsj_centerline(rectum_length=0.04, sigmoid_radius=FLEXURE_RADIUS, sigmoid_an
 
 def rsf_centerline(alpha_deg=0.0, rectum_length=0.04, sigmoid_length=0.20, descending_length=0.10,
                    flexure_radius=FLEXURE_RADIUS, flexure_angle_deg=FLEXURE_ANGLE_DEG, fillet_radius=FILLET_RADIUS,
-                   exit_length=EXIT_LENGTH):
+                   exit_length=EXIT_LENGTH, exit_fold_after=None):
     """Rectum to splenic flexure with the sigmoid tilted by ``alpha_deg``, then a fixed exit.
 
     Reading of "tilted by alpha" (**assumption**): rectum and descending colon are parallel (the
@@ -79,6 +99,8 @@ def rsf_centerline(alpha_deg=0.0, rectum_length=0.04, sigmoid_length=0.20, desce
         m (assumption 5 cm).
     exit_length : float
         m, fixed straight after the flexure (assumption 10 cm; 0: the tube ends at the flexure).
+    exit_fold_after : float or None
+        m of exit after which a longer exit folds out of the plane (:func:`exit_pieces`; None: straight).
     """
     if not (np.isfinite(alpha_deg) and 0.0 <= alpha_deg < 90.0):
         raise ColonsimError(f"alpha = {alpha_deg!r} deg is outside 0 <= alpha < 90 deg (the sigmoid must climb "
@@ -91,13 +113,12 @@ def rsf_centerline(alpha_deg=0.0, rectum_length=0.04, sigmoid_length=0.20, desce
               Kink(a),
               Straight(descending_length, "fixed", "descending"),
               Arc(flexure_radius, np.radians(flexure_angle_deg), "fixed", "splenic flexure")]
-    if exit_length != 0.0:
-        pieces.append(Straight(exit_length, "fixed", "transverse"))
+    pieces += exit_pieces(exit_length, "transverse", exit_fold_after)
     return Centerline(pieces, fillet_radius=fillet_radius)
 
 
 def thf_centerline(beta_deg=0.0, span=0.20, flexure_radius=FLEXURE_RADIUS, flexure_angle_deg=FLEXURE_ANGLE_DEG,
-                   fillet_radius=FILLET_RADIUS, exit_length=EXIT_LENGTH, fixed_transverse=False):
+                   fillet_radius=FILLET_RADIUS, exit_length=EXIT_LENGTH, fixed_transverse=False, exit_fold_after=None):
     """Transverse colon drooping as a V of angle ``beta_deg``, hepatic flexure, ascending colon.
 
     Reading (**assumptions**): the scope enters the transverse colon directly at its splenic end
@@ -122,6 +143,8 @@ def thf_centerline(beta_deg=0.0, span=0.20, flexure_radius=FLEXURE_RADIUS, flexu
         Length of the fixed ascending colon, m (10 cm; 0: the tube ends at the flexure).
     fixed_transverse : bool
         True for the fixed THF model (no mobile part).
+    exit_fold_after : float or None
+        m of exit after which a longer exit folds out of the plane (:func:`exit_pieces`; None: straight).
     """
     _check_angle("beta", beta_deg, 0.0, 60.0, "a steeper V is not a transverse colon")
     _check_angle("hepatic flexure angle", flexure_angle_deg, 1e-9, 180.0, "a flexure turns by at most 180 deg")
@@ -133,8 +156,7 @@ def thf_centerline(beta_deg=0.0, span=0.20, flexure_radius=FLEXURE_RADIUS, flexu
               Kink(-2.0 * b),
               Straight(arm, tag, "transverse"),
               Arc(flexure_radius, np.radians(flexure_angle_deg), "fixed", "hepatic flexure")]
-    if exit_length != 0.0:
-        pieces.append(Straight(exit_length, "fixed", "ascending"))
+    pieces += exit_pieces(exit_length, "ascending", exit_fold_after)
     return Centerline(pieces, fillet_radius=fillet_radius)
 
 

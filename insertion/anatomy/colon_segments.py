@@ -133,11 +133,13 @@ def exit_start(centerline):
     return float(centerline.s_start[-1])
 
 
-def _tube_geometry(centerline, diameter, element_size, wall_thickness) -> ColonGeometry:
+def _tube_geometry(centerline, diameter, element_size, wall_thickness, exit_length=None) -> ColonGeometry:
     """The wall of ``centerline`` meshed at its mid-surface, with the mesh kept for the catalog's rules.
 
     ``diameter`` is the lumen diameter, m, or a patient's profile ``D(s)``: the wall's outer
-    surface must clear every bend (D/2 + t below the bend radius)."""
+    surface must clear every bend (D/2 + t below the bend radius). ``exit_length`` (m): the length
+    of an exit made of several pieces (a folded one), which then begins that far before the end;
+    None: the exit is the last piece (:func:`exit_start`)."""
     if callable(diameter):
         centerline.check_bend(lambda s: 0.5 * diameter(s) + wall_thickness, "the colon wall's outer surface")
         mesh = tube_mesh(centerline, lambda s: diameter(s) + wall_thickness, element_size)
@@ -150,7 +152,9 @@ def _tube_geometry(centerline, diameter, element_size, wall_thickness) -> ColonG
                          entry_point=centerline.position(0.0), entry_axis=centerline.tangent(0.0),
                          centerline_length=centerline.length,
                          centerline_points=lambda s: centerline.position(np.atleast_1d(s)),
-                         mobile_end=mobile_end(centerline), exit_start=exit_start(centerline), tube=mesh)
+                         mobile_end=mobile_end(centerline),
+                         exit_start=exit_start(centerline) if exit_length is None else centerline.length - exit_length,
+                         tube=mesh)
 
 
 def straight_colon(length, diameter, element_size, wall_thickness, fixed_length=0.0) -> ColonGeometry:
@@ -166,32 +170,48 @@ def straight_colon(length, diameter, element_size, wall_thickness, fixed_length=
     )
 
 
-# The builders the catalog names (colonsim.catalog.ColonModel.builder): one signature, SI units.
+# The builders the catalog names (colonsim.catalog.ColonModel.builder): one signature, SI units;
+# ``exit_fold_after`` (m): a longer exit folds out of the model's plane after that much
+# (colonsim.insertion.anatomy.colon_centerlines.exit_pieces; None: straight).
 
-def rsj_geometry(diameter, angle_deg, element_size, wall_thickness, exit_length, flexure_angle_deg):
-    """RSJ (:func:`colonsim.insertion.anatomy.centerline.rsj_centerline`); no angle, no flexure."""
+def _exit_length(exit_length, exit_fold_after):
+    """The exit length :func:`_tube_geometry` needs: given only for a folded exit."""
+    return exit_length if exit_fold_after is not None and exit_length > exit_fold_after else None
+
+
+def rsj_geometry(diameter, angle_deg, element_size, wall_thickness, exit_length, flexure_angle_deg,
+                 exit_fold_after=None):
+    """RSJ (:func:`colonsim.insertion.anatomy.centerline.rsj_centerline`); no angle, no flexure, and
+    a straight exit (the RSJ's is never lengthened)."""
     return _tube_geometry(rsj_centerline(exit_length=exit_length), diameter, element_size, wall_thickness)
 
 
-def rsf_geometry(diameter, angle_deg, element_size, wall_thickness, exit_length, flexure_angle_deg):
+def rsf_geometry(diameter, angle_deg, element_size, wall_thickness, exit_length, flexure_angle_deg,
+                 exit_fold_after=None):
     """RSF with the sigmoid tilted by alpha = ``angle_deg``."""
-    c = rsf_centerline(angle_deg, flexure_angle_deg=flexure_angle_deg, exit_length=exit_length)
-    return _tube_geometry(c, diameter, element_size, wall_thickness)
+    c = rsf_centerline(angle_deg, flexure_angle_deg=flexure_angle_deg, exit_length=exit_length,
+                       exit_fold_after=exit_fold_after)
+    return _tube_geometry(c, diameter, element_size, wall_thickness, _exit_length(exit_length, exit_fold_after))
 
 
-def thf_geometry(diameter, angle_deg, element_size, wall_thickness, exit_length, flexure_angle_deg):
+def thf_geometry(diameter, angle_deg, element_size, wall_thickness, exit_length, flexure_angle_deg,
+                 exit_fold_after=None):
     """THF with the transverse V at beta = ``angle_deg``."""
-    c = thf_centerline(angle_deg, flexure_angle_deg=flexure_angle_deg, exit_length=exit_length)
-    return _tube_geometry(c, diameter, element_size, wall_thickness)
+    c = thf_centerline(angle_deg, flexure_angle_deg=flexure_angle_deg, exit_length=exit_length,
+                       exit_fold_after=exit_fold_after)
+    return _tube_geometry(c, diameter, element_size, wall_thickness, _exit_length(exit_length, exit_fold_after))
 
 
-def thf_fixed_geometry(diameter, angle_deg, element_size, wall_thickness, exit_length, flexure_angle_deg):
+def thf_fixed_geometry(diameter, angle_deg, element_size, wall_thickness, exit_length, flexure_angle_deg,
+                       exit_fold_after=None):
     """Fixed THF: the THF centerline with the transverse colon fixed too."""
-    c = thf_fixed_centerline(angle_deg, flexure_angle_deg=flexure_angle_deg, exit_length=exit_length)
-    return _tube_geometry(c, diameter, element_size, wall_thickness)
+    c = thf_fixed_centerline(angle_deg, flexure_angle_deg=flexure_angle_deg, exit_length=exit_length,
+                             exit_fold_after=exit_fold_after)
+    return _tube_geometry(c, diameter, element_size, wall_thickness, _exit_length(exit_length, exit_fold_after))
 
 
-def straight_geometry(diameter, angle_deg, element_size, wall_thickness, exit_length, flexure_angle_deg):
+def straight_geometry(diameter, angle_deg, element_size, wall_thickness, exit_length, flexure_angle_deg,
+                      exit_fold_after=None):
     """The 20 cm straight tube, mobile throughout; no angle, no exit."""
     return straight_colon(STRAIGHT_LENGTH, diameter, element_size, wall_thickness)
 
@@ -216,7 +236,7 @@ def check_patient_tube(centerline, diameter, wall_thickness):
 
 
 def patient_geometry(diameter, angle_deg, element_size, wall_thickness, exit_length, flexure_angle_deg,
-                     centerline=None):
+                     exit_fold_after=None, centerline=None):
     """A patient's centerline (:class:`colonsim.insertion.anatomy.patient_centerline.PatientCenterline`)
     as it is: angle, flexure and exit do not apply; the lumen is the file's diameter profile when
     it has one (``diameter`` must then be its median), else ``diameter``. The wall's bend and
@@ -238,7 +258,7 @@ def _builder(model):
 
 
 def colon_geometry(segment, diameter, angle_deg, element_size, wall_thickness, exit_length=EXIT_LENGTH,
-                   flexure_angle_deg=FLEXURE_ANGLE_DEG, centerline=None) -> ColonGeometry:
+                   flexure_angle_deg=FLEXURE_ANGLE_DEG, centerline=None, exit_fold_after=None) -> ColonGeometry:
     """The geometry of the catalog's colon model ``segment`` (:data:`colonsim.catalog.COLON_MODELS`).
 
     Builds it with the model's builder, then applies the model's rules: the mobile piece a
@@ -256,6 +276,9 @@ def colon_geometry(segment, diameter, angle_deg, element_size, wall_thickness, e
         m, the fixed straight every model continues into after its last mobile piece (10 cm).
     flexure_angle_deg : float
         Turn of the splenic (RSF) or hepatic (THF) flexure, deg (90).
+    exit_fold_after : float or None
+        m: an exit longer than this folds out of the model's plane after it (the models whose exit
+        takes the whole available length, where a straight one would cut the tube; None: straight).
     centerline : PatientCenterline or None
         The user's centerline, for (and only for) a model that reads one (``reads_centerline``:
         ``patient``), from :func:`colonsim.insertion.anatomy.patient_centerline.load_patient_centerline`.
@@ -270,7 +293,7 @@ def colon_geometry(segment, diameter, angle_deg, element_size, wall_thickness, e
         raise ColonsimError(f"exit length {exit_length * 1e3:g} mm must lie in 0-{EXIT_LIMIT * 1e3:g} mm")
     extra = {"centerline": centerline} if model.reads_centerline else {}
     geometry = _builder(model)(diameter, angle_deg, element_size, wall_thickness, exit_length, flexure_angle_deg,
-                               **extra)
+                               exit_fold_after=exit_fold_after, **extra)
     geometry.name = model.name
     if model.straightens or model.end_rule == PAST_MOBILE_END:
         if geometry.tube is None:

@@ -42,6 +42,7 @@ import numpy as np
 
 from colonsim.catalog import CONTINUOUS_PUSH, colon_model
 from colonsim.errors import ColonsimError
+from colonsim.insertion.anatomy.centerline import TubeClash
 from colonsim.insertion.anatomy.colon_segments import EXIT_LIMIT, colon_geometry
 from colonsim.insertion.anatomy.manoeuvre import SETTLE, PushProfile, continuous_push, straighten_relax_push
 from colonsim.insertion.anatomy.scopes import colonoscope
@@ -93,10 +94,10 @@ def build_insertion(case: InsertionCase) -> Insertion:
     D = case.diameter_mm * 1e-3
     anatomy = colon_model(case.segment)
 
-    def geometry_with_exit(exit_length):
+    def geometry_with_exit(exit_length, fold_after=None):
         return colon_geometry(case.segment, D, case.angle_deg, case.element_size_mm * 1e-3,
                               case.wall_thickness_mm * 1e-3, exit_length, case.flexure_angle_deg,
-                              centerline=case.patient_centerline())
+                              centerline=case.patient_centerline(), exit_fold_after=fold_after)
 
     exit_length = case.exit_length_mm * 1e-3
     geometry = geometry_with_exit(exit_length)
@@ -108,7 +109,10 @@ def build_insertion(case: InsertionCase) -> Insertion:
             raise ColonsimError(f"the exit would need {needed * 100:.0f} cm to take the scope's available length, "
                                 f"more than {EXIT_LIMIT * 100:.0f} cm; keep more in the sheath (sheath_reserve_mm)")
         if needed > exit_length:
-            geometry = geometry_with_exit(needed)
+            try:
+                geometry = geometry_with_exit(needed)
+            except TubeClash:  # run straight on, the exit would cross the colon: it folds out of the plane
+                geometry = geometry_with_exit(needed, fold_after=exit_length)
     material = case_material(case.material, case.material_parameters)
     shell = Shell(geometry.nodes, geometry.triangles, case.wall_thickness_mm * 1e-3, material,
                   density=COLON_DENSITY, name="colon")
