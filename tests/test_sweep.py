@@ -170,8 +170,9 @@ def test_store_rows_follow_the_contract_and_the_table_is_replaced_atomically(tmp
     assert row["material"] == "" and row["scope"] == "10.5" and row["scope_diameter_mm"] == pytest.approx(10.5)
     # a failed run has no outputs: NaN numbers, False checks, no ending
     assert row["quasi_static"] is False and row["kinetic_energy_check"] is False and math.isnan(row["ringing_ratio"]) and row["ended_by"] == ""
+    assert row["came_to_rest"] is False
     assert all(math.isnan(row[k]) for k in OUTPUTS
-               if k not in ("quasi_static", "kinetic_energy_check", "ended_by"))
+               if k not in ("quasi_static", "kinetic_energy_check", "came_to_rest", "ended_by"))
     with SweepStore(tmp_path) as store:
         store.record(case, outcome)
         assert store.finished() == {case.key()} and store.finished(retry_failed=True) == set()
