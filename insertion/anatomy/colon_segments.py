@@ -174,9 +174,15 @@ def straight_colon(length, diameter, element_size, wall_thickness, fixed_length=
 # ``exit_fold_after`` (m): a longer exit folds out of the model's plane after that much
 # (colonsim.insertion.anatomy.colon_centerlines.exit_pieces; None: straight).
 
-def _exit_length(exit_length, exit_fold_after):
-    """The exit length :func:`_tube_geometry` needs: given only for a folded exit."""
-    return exit_length if exit_fold_after is not None and exit_length > exit_fold_after else None
+def _flexure_geometry(centerline_of, diameter, angle_deg, element_size, wall_thickness, exit_length,
+                      flexure_angle_deg, exit_fold_after):
+    """The tube of a model whose flexure leads into a lengthened exit: ``centerline_of`` (one of
+    the centerline builders) at the angle, flexure and exit given. A folded exit has several
+    pieces, so :func:`_tube_geometry` is told its length; a straight one is the last piece."""
+    c = centerline_of(angle_deg, flexure_angle_deg=flexure_angle_deg, exit_length=exit_length,
+                      exit_fold_after=exit_fold_after)
+    folded = exit_fold_after is not None and exit_length > exit_fold_after
+    return _tube_geometry(c, diameter, element_size, wall_thickness, exit_length if folded else None)
 
 
 def rsj_geometry(diameter, angle_deg, element_size, wall_thickness, exit_length, flexure_angle_deg,
@@ -189,25 +195,22 @@ def rsj_geometry(diameter, angle_deg, element_size, wall_thickness, exit_length,
 def rsf_geometry(diameter, angle_deg, element_size, wall_thickness, exit_length, flexure_angle_deg,
                  exit_fold_after=None):
     """RSF with the sigmoid tilted by alpha = ``angle_deg``."""
-    c = rsf_centerline(angle_deg, flexure_angle_deg=flexure_angle_deg, exit_length=exit_length,
-                       exit_fold_after=exit_fold_after)
-    return _tube_geometry(c, diameter, element_size, wall_thickness, _exit_length(exit_length, exit_fold_after))
+    return _flexure_geometry(rsf_centerline, diameter, angle_deg, element_size, wall_thickness, exit_length,
+                             flexure_angle_deg, exit_fold_after)
 
 
 def thf_geometry(diameter, angle_deg, element_size, wall_thickness, exit_length, flexure_angle_deg,
                  exit_fold_after=None):
     """THF with the transverse V at beta = ``angle_deg``."""
-    c = thf_centerline(angle_deg, flexure_angle_deg=flexure_angle_deg, exit_length=exit_length,
-                       exit_fold_after=exit_fold_after)
-    return _tube_geometry(c, diameter, element_size, wall_thickness, _exit_length(exit_length, exit_fold_after))
+    return _flexure_geometry(thf_centerline, diameter, angle_deg, element_size, wall_thickness, exit_length,
+                             flexure_angle_deg, exit_fold_after)
 
 
 def thf_fixed_geometry(diameter, angle_deg, element_size, wall_thickness, exit_length, flexure_angle_deg,
                        exit_fold_after=None):
     """Fixed THF: the THF centerline with the transverse colon fixed too."""
-    c = thf_fixed_centerline(angle_deg, flexure_angle_deg=flexure_angle_deg, exit_length=exit_length,
-                             exit_fold_after=exit_fold_after)
-    return _tube_geometry(c, diameter, element_size, wall_thickness, _exit_length(exit_length, exit_fold_after))
+    return _flexure_geometry(thf_fixed_centerline, diameter, angle_deg, element_size, wall_thickness, exit_length,
+                             flexure_angle_deg, exit_fold_after)
 
 
 def straight_geometry(diameter, angle_deg, element_size, wall_thickness, exit_length, flexure_angle_deg,
