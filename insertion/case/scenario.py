@@ -48,6 +48,7 @@ from colonsim.insertion.anatomy.manoeuvre import SETTLE, PushProfile, continuous
 from colonsim.insertion.anatomy.scopes import colonoscope
 from colonsim.insertion.case.case_material import case_material
 from colonsim.insertion.case.insertion_case import InsertionCase
+from colonsim.insertion.case.lumen_guard import check_scope_inside
 from colonsim.insertion.case.outcomes import REST_TOLERANCE, REST_WINDOW, rest_drift
 from colonsim.insertion.case.recording import InsertionRecorder
 from colonsim.insertion.case.run_summary import end_state, summarize, tip_passed_end
@@ -234,6 +235,7 @@ def came_to_rest(rows) -> bool:
 
 
 CHUNK_PUSH = 1e-3  # m: the end rules are checked after every millimetre of push (at most every 10 ms)
+GUARD_CHUNKS = 5  # chunks between two checks that the scope is still inside the colon (lumen_guard)
 
 
 def run_insertion(case: InsertionCase, progress=None, snapshot_interval=None) -> InsertionResult:
@@ -257,6 +259,7 @@ def run_insertion(case: InsertionCase, progress=None, snapshot_interval=None) ->
     chunk_s = min(0.01, CHUNK_PUSH / case.push_speed)
     ended_by = None
     settling = at_rest = False
+    chunks = 0
     while model.solver.time < push.duration - 1e-9:
         if not settling and push.settle_start is not None and model.solver.time >= push.settle_start:
             settling = True
@@ -269,6 +272,9 @@ def run_insertion(case: InsertionCase, progress=None, snapshot_interval=None) ->
         if not recorder.rows or recorder.rows[-1]["time_s"] < model.solver.time:
             recorder(model.solver)  # the state at the end of every chunk is a sample
         last = recorder.rows[-1]
+        chunks += 1
+        if chunks % GUARD_CHUNKS == 0:
+            check_scope_inside(model, last["depth_m"])
         if progress is not None:
             progress(model.solver.time, last["tip_arc_m"], model.tip_end)
         held = False
@@ -294,6 +300,7 @@ def run_insertion(case: InsertionCase, progress=None, snapshot_interval=None) ->
             break  # a jam or a tear ends where it happened, under its load; a profile without a settle phase, at its rule
         push.stop(model.solver.time, case.stop_distance_mm * 1e-3, case.settle_max_s)
     ended_by = ended_by or "length_used"
+    check_scope_inside(model, recorder.rows[-1]["depth_m"])
     wall = time.perf_counter() - t0
     frame = recorder.frame()
     summary = summarize(model, frame, wall, t0 - t_build)

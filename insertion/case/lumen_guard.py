@@ -1,0 +1,57 @@
+"""Has the scope left the colon through its wall? (docs/model.md, "Contact")
+
+The contact holds the scope back from the wall's nodes, not from its faces: a scope thin next to
+the wall's elements, pushed hard against a stretched wall, can slip between three nodes and go on
+outside the colon. Nothing in the contact then notices (the nodes it passed are behind it), and
+the run would go on reporting the displaced wall as colon deformation. This module recognises
+that state from the geometry alone, so a run can stop with the fix instead of results.
+
+The test: each scope node, measured from its nearest wall node along that node's outward normal
+(the deformed wall's, area-weighted over its triangles; tube meshes are oriented out of the
+lumen). Inside the colon the scope's axis lies at least its radius plus half the wall thickness
+inside the wall (the contact's gap, less a penetration of a fraction of a millimetre). A scope
+whose axis lies more than :data:`OUTSIDE_MARGIN` scope radii beyond the wall's mid-surface plus
+half its thickness is outside: its whole cross-section is beyond the wall's outer surface, which
+no contact state reaches (a margin of one radius on top of the geometry leaves room for the
+nearest node's normal being tilted on a coarse or folded wall). Scope nodes still in the sheath,
+on the entry axis behind the first ring, lie inside the ring's normals and are not flagged.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from scipy.spatial import cKDTree
+
+from colonsim.errors import ColonsimError
+
+OUTSIDE_MARGIN = 1.0  # scope radii beyond the wall's outer surface: the scope's axis is then outside the colon
+
+
+def depth_outside_wall(scope_x, wall_x, wall_normals, half_thickness):
+    """How far each scope node lies beyond the wall's outer surface, m (negative: inside the lumen
+    or the wall), measured from its nearest wall node along that node's outward normal.
+
+    Parameters
+    ----------
+    scope_x : (k, 3) scope node positions, m.
+    wall_x, wall_normals : (n, 3) wall node positions (mid-surface), m, and unit outward normals.
+    half_thickness : float, m.
+    """
+    _, nearest = cKDTree(wall_x).query(scope_x)
+    return np.einsum("ij,ij->i", scope_x - wall_x[nearest], wall_normals[nearest]) - half_thickness
+
+
+def check_scope_inside(model, depth_m):
+    """Raise :class:`ColonsimError` when the scope of the built insertion ``model`` has left the
+    colon through its wall (see the module docstring); ``depth_m`` is the push so far, for the
+    message."""
+    wall_x = model.solver.state["colon"].x
+    scope_x = model.solver.state[model.rod.name].x
+    outside = depth_outside_wall(scope_x, wall_x, model.shell.node_normals(wall_x), 0.5 * model.shell.thickness)
+    k = int(np.argmax(outside))
+    if outside[k] > OUTSIDE_MARGIN * model.rod.radius:
+        case = model.case
+        raise ColonsimError(
+            f"the scope left the colon through its wall {depth_m * 100:.1f} cm into the push "
+            f"(scope node {k} is {outside[k] * 1e3:.1f} mm beyond the wall): the {case.element_size_mm:g} mm wall "
+            f"mesh is too coarse for a {2e3 * model.rod.radius:.1f} mm scope; use a finer --element-size (the default is 3 mm)")
