@@ -11,6 +11,12 @@ import os
 import shutil
 import tempfile
 
+# Under pytest-xdist (the README's test command runs one pytest process per core) every process,
+# and the notebook kernels and sweep workers it starts, runs one Numba thread: two processes of two
+# threads each on two cores wait on each other's threads (measured with a 2-process sweep also
+# running: the insertion fixtures took 10 times longer).
+if "PYTEST_XDIST_WORKER" in os.environ:
+    os.environ.setdefault("NUMBA_NUM_THREADS", "1")
 os.environ.setdefault("COLONSIM_NOTEBOOK_SIZE", "reduced")
 _TEMPORARY_OUTPUT = None
 if "COLONSIM_NOTEBOOK_OUTPUT" not in os.environ:

@@ -37,6 +37,13 @@ PAST_JUNCTION = 0.02  # m, how far past the fixed end of the mobile piece a PAST
 # bow before its tip reaches the far end, and plus the length kept in the sheath.
 SCOPE_LENGTH_MARGIN = 0.20
 ANGLE_LIMITS_DEG = (0.0, 60.0)  # RSF alpha and THF beta; the source used 0, 30, 45
+# The smoke size of an insertion (tests, the smoke preset, the demo's check): the coarsest wall
+# mesh, mm, on which every catalogue scope stays inside the RSJ colon (on 6 and 7.5 mm the thin
+# scopes leave it through the wall, which the run then refuses: docs/model.md, "Contact"), with
+# scope nodes twice as far apart as the default so that the scope does not set a short time step.
+# Not physics: for checking that things run.
+SMOKE_ELEMENT_MM = 5.0
+SMOKE_SCOPE_SPACING_MM = 10.0
 _BUILDERS = "colonsim.insertion.anatomy.colon_segments"
 
 

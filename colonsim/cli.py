@@ -96,9 +96,13 @@ def cmd_demo(args):
     from colonsim.demo import DemoOptions, run_demo
 
     check_input_range("element_size_mm", args.element_size, "--element-size: ")  # before the calibration runs
+    if args.scope_spacing is not None:  # the case's own range check, before the calibration runs
+        from colonsim.insertion.case.insertion_case import InsertionCase
 
-    run_demo(DemoOptions(out=args.out, element_size_mm=args.element_size, workers=args.workers,
-                         show_progress=not args.no_progress, target=args.target))
+        InsertionCase(scope_spacing_mm=args.scope_spacing).validate()
+
+    run_demo(DemoOptions(out=args.out, element_size_mm=args.element_size, scope_spacing_mm=args.scope_spacing,
+                         workers=args.workers, show_progress=not args.no_progress, target=args.target))
 
 
 def _add_insert(sub):
@@ -122,6 +126,8 @@ def _add_insert(sub):
     p.add_argument("--friction", type=finite_float, default=0.0, help="Coulomb friction scope/wall (default 0)")
     p.add_argument("--wall-thickness", type=finite_float, default=2.0, help="colon wall thickness, mm (default 2, an assumption)")
     p.add_argument("--element-size", type=finite_float, default=3.0, help="wall triangle size, mm (default 3)")
+    p.add_argument("--scope-spacing", type=finite_float, default=None,
+                   help="scope node spacing, mm (default 5; coarser is faster, not validated)")
     p.add_argument("--material", help="material JSON from colonsim calibrate (default: the source's parameters)")
     p.add_argument("--flexure-angle", type=finite_float, default=90.0,
                    help="turn of the splenic (RSF) or hepatic (THF) flexure, degrees (default 90, an assumption)")
@@ -168,7 +174,8 @@ def cmd_insert(args):
                            flexure_angle_deg=args.flexure_angle, friction=args.friction,
                            wall_thickness_mm=args.wall_thickness,
                            element_size_mm=args.element_size, material=args.material,
-                           exit_length_mm=args.exit_length, distal_resistance_N=args.distal_resistance)
+                           exit_length_mm=args.exit_length, distal_resistance_N=args.distal_resistance,
+                           **({} if args.scope_spacing is None else {"scope_spacing_mm": args.scope_spacing}))
              for scope in args.scope]
     if args.material is not None:
         from colonsim.inputs import check_input
@@ -203,6 +210,9 @@ def build_parser():
     demo.add_argument("--out", type=output_folder, default="colonsim_demo", help="output folder (default colonsim_demo)")
     demo.add_argument("--element-size", type=finite_float, default=3.0,
                       help="wall mesh of the insertions and the sweep, mm (default 3; coarser is faster, not validated)")
+    demo.add_argument("--scope-spacing", type=finite_float, default=None,
+                      help="scope node spacing of the insertions and the sweep, mm (default 5; coarser is faster, "
+                           "not validated)")
     demo.add_argument("--workers", type=worker_count, default=None,
                       help="processes for the demo's sweep (default: up to 2 cores)")
     demo.add_argument("--no-progress", action="store_true", help="no progress bar")

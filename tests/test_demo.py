@@ -1,7 +1,8 @@
 """``colonsim demo`` end to end on a coarse wall mesh: every step runs and writes what the README promises.
 
-The full demo uses the 3 mm mesh (a few minutes on 2 cores); 7.5 mm keeps this check near two
-minutes. The numbers at 7.5 mm are not physics (too coarse), so only their consistency is checked.
+The full demo uses the 3 mm mesh (a few minutes on 2 cores); the smoke size (a 5 mm wall mesh,
+scope nodes every 10 mm: colonsim.catalog) keeps this check near two minutes. Its numbers are not
+physics (too coarse), so only their consistency is checked.
 """
 
 import json
@@ -9,13 +10,15 @@ import json
 import pandas as pd
 import pytest
 
+from colonsim.catalog import SMOKE_ELEMENT_MM, SMOKE_SCOPE_SPACING_MM
 from colonsim.cli import main
 
 
 @pytest.mark.slow
 def test_demo_runs_every_workflow_and_writes_one_folder(tmp_path, capsys):
     out = tmp_path / "demo"
-    assert main(["demo", "--out", str(out), "--element-size", "7.5", "--no-progress"]) in (None, 0)
+    assert main(["demo", "--out", str(out), "--element-size", str(SMOKE_ELEMENT_MM),
+                 "--scope-spacing", str(SMOKE_SCOPE_SPACING_MM), "--no-progress"]) in (None, 0)
     text = capsys.readouterr().out
     for step in ("1/5", "2/5", "3/5", "4/5", "5/5", "summary"):
         assert f"== {step}" in text
@@ -27,7 +30,7 @@ def test_demo_runs_every_workflow_and_writes_one_folder(tmp_path, capsys):
     assert len(table) == 12 and (table["status"] == "ok").all()
     assert set(table["diameter_mm"]) == {23.0, 36.0} and set(table["friction"]) == {0.0, 0.1}
     replicates = pd.read_parquet(out / "replicates" / "results.parquet")
-    assert len(replicates) == 4 and set(replicates["element_size_mm"]) == {6.975}
+    assert len(replicates) == 4 and set(replicates["element_size_mm"]) == {round(0.93 * SMOKE_ELEMENT_MM, 3)}
     assert (out / "surrogate.json").is_file() and (out / "surrogate.npz").is_file()
     doc = json.loads((out / "surrogate.json").read_text())
     assert doc["segments"]["rsj"]["models"]["max_deformation_cm"]["scatter"]["pairs"] == 4
@@ -44,6 +47,6 @@ def test_demo_runs_every_workflow_and_writes_one_folder(tmp_path, capsys):
         means = [s["mean"] for s in rec["scopes"]]
         assert means == sorted(means)  # the ranking is by predicted deformation
     report = (out / "report.md").read_text()
-    assert "7.5 mm wall mesh" in report and "![RSJ insertions](insertion/comparison.png)" in report
+    assert f"{SMOKE_ELEMENT_MM:g} mm wall mesh with scope nodes every {SMOKE_SCOPE_SPACING_MM:g} mm" in report and "![RSJ insertions](insertion/comparison.png)" in report
     for figure in ("insertion/comparison.png", "surrogate_vs_diameter_mm.png", "surrogate_vs_friction.png"):
         assert (out / figure).stat().st_size > 10_000

@@ -44,6 +44,8 @@ def test_a_scope_outside_the_tube_is_flagged_and_one_inside_is_not(straight):
     radius = straight.rod.radius
     scope[-1] = [0.10, outer + 0.5 * OUTSIDE_MARGIN * radius, 0.0]  # half the margin beyond: not yet
     check_scope_inside(straight, 0.05)
+    scope[0] = [-0.02, outer + 3.0 * radius, 0.0]  # behind the entry plane: the sheath's part, not measured
+    check_scope_inside(straight, 0.05)
     scope[-1] = [0.10, outer + 1.5 * OUTSIDE_MARGIN * radius, 0.0]  # the tip's whole section outside
     with pytest.raises(ColonsimError, match=r"left the colon through its wall 5\.0 cm into the push.*finer --element-size"):
         check_scope_inside(straight, 0.05)

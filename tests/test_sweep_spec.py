@@ -8,6 +8,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from colonsim.catalog import SMOKE_ELEMENT_MM
 from colonsim.cli import main
 from colonsim.errors import ColonsimError
 from colonsim.insertion.engine.material import REFERENCE_MATERIAL_PATH
@@ -53,7 +54,7 @@ def test_validation_preset_pairs_each_model_with_the_thesis_runs():
 
 def test_smoke_preset_is_small_and_coarse():
     cases = load_sweep(preset="smoke").cases
-    assert 3 <= len(cases) <= 4 and all(c.element_size_mm >= 6 for c in cases)
+    assert 3 <= len(cases) <= 4 and all(c.element_size_mm == SMOKE_ELEMENT_MM > 3.0 for c in cases)
     assert {c.segment for c in cases} == {"straight", "rsj"}
 
 

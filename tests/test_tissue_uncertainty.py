@@ -12,7 +12,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from colonsim.catalog import WALL_C11, WALL_MU0
+from colonsim.catalog import SMOKE_ELEMENT_MM, SMOKE_SCOPE_SPACING_MM, WALL_C11, WALL_MU0
 from colonsim.cli import main
 from colonsim.errors import ColonsimError
 from colonsim.surrogate import OutOfDomainWarning, SegmentDomain, SweepSurrogate
@@ -223,13 +223,15 @@ def test_cli_material_option_and_one_line_errors(fitted, tmp_path, capsys):
 
 @pytest.mark.slow
 def test_a_real_sweep_over_drawn_materials_end_to_end(tmp_path, capsys):
-    """RSJ on the 7.5 mm smoke mesh, 2 scopes x 3 posterior draws (about 30 s on one core; the straight
-    tube is not used: its scope never touches the wall, so every output is 0 whatever the tissue)."""
+    """RSJ at the smoke size (colonsim.catalog), 2 scopes x 3 posterior draws (about 30 s on one
+    core; the straight tube is not used: its scope never touches the wall, so every output is 0
+    whatever the tissue)."""
     from colonsim.insertion.study.sweep import run_sweep
     from colonsim.insertion.study.sweep_spec import parse_sweep
 
     material_file(tmp_path, mean=[14_400.0, 33_000.0, 153_000.0], cov=np.diag([4e6, 4e6, 9e6]))
-    spec = parse_sweep('[fixed]\nelement_size_mm = 7.5\n[[grid]]\nsegment = "rsj"\nscope = ["utc", "sdc"]\n'
+    spec = parse_sweep(f'[fixed]\nelement_size_mm = {SMOKE_ELEMENT_MM}\nscope_spacing_mm = {SMOKE_SCOPE_SPACING_MM}\n'
+                       '[[grid]]\nsegment = "rsj"\nscope = ["utc", "sdc"]\n'
                        '[material]\nfile = "material.json"\nsamples = 3\nseed = 2\n', base=tmp_path)
     report = run_sweep(spec.cases, tmp_path / "sweep", workers=2, spec=spec, progress=False, log=lambda *a: None)
     table = report.table

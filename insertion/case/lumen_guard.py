@@ -13,8 +13,9 @@ inside the wall (the contact's gap, less a penetration of a fraction of a millim
 whose axis lies more than :data:`OUTSIDE_MARGIN` scope radii beyond the wall's mid-surface plus
 half its thickness is outside: its whole cross-section is beyond the wall's outer surface, which
 no contact state reaches (a margin of one radius on top of the geometry leaves room for the
-nearest node's normal being tilted on a coarse or folded wall). Scope nodes still in the sheath,
-on the entry axis behind the first ring, lie inside the ring's normals and are not flagged.
+nearest node's normal being tilted on a coarse or folded wall). Only the scope nodes past the
+entry plane are measured: those behind it are in the sheath, outside the model by design (the
+proximal end lies a scope's length back, where the nearest wall may well face it).
 """
 
 from __future__ import annotations
@@ -47,11 +48,15 @@ def check_scope_inside(model, depth_m):
     message."""
     wall_x = model.solver.state["colon"].x
     scope_x = model.solver.state[model.rod.name].x
-    outside = depth_outside_wall(scope_x, wall_x, model.shell.node_normals(wall_x), 0.5 * model.shell.thickness)
+    inserted = np.flatnonzero((scope_x - model.entry_point) @ model.entry_axis > 0.0)
+    if not inserted.size:
+        return
+    outside = depth_outside_wall(scope_x[inserted], wall_x, model.shell.node_normals(wall_x),
+                                 0.5 * model.shell.thickness)
     k = int(np.argmax(outside))
     if outside[k] > OUTSIDE_MARGIN * model.rod.radius:
         case = model.case
         raise ColonsimError(
             f"the scope left the colon through its wall {depth_m * 100:.1f} cm into the push "
-            f"(scope node {k} is {outside[k] * 1e3:.1f} mm beyond the wall): the {case.element_size_mm:g} mm wall "
+            f"(scope node {inserted[k]} is {outside[k] * 1e3:.1f} mm beyond the wall): the {case.element_size_mm:g} mm wall "
             f"mesh is too coarse for a {2e3 * model.rod.radius:.1f} mm scope; use a finer --element-size (the default is 3 mm)")

@@ -2,6 +2,8 @@
 :mod:`colonsim.insertion.study.sweep_spec` reads, one entry per preset.
 """
 
+from colonsim.catalog import SMOKE_ELEMENT_MM, SMOKE_SCOPE_SPACING_MM
+
 PRESETS = {
     # The source's Chapter V: RSJ D23/D36 x 3 scopes x mu 0/0.05/0.1 (18 runs); RSF alpha and THF
     # beta 0/30/45 x 3 scopes at mu 0 (18); fixed THF x 3 scopes (3). The scopes have the
@@ -111,13 +113,14 @@ distal_resistance_N = 10
 push_speed = 0.15
 """,
     # A few runs of a few seconds each on a coarse wall mesh: for tests and for checking a setup.
-    "smoke": """
+    "smoke": f"""
 [sweep]
 name = "smoke"
-description = "Three fast runs on a coarse 7.5 mm wall mesh (tests, setup checks); not physics"
+description = "Three fast runs on a coarse {SMOKE_ELEMENT_MM:g} mm wall mesh (tests, setup checks); not physics"
 
 [fixed]
-element_size_mm = 7.5
+element_size_mm = {SMOKE_ELEMENT_MM}
+scope_spacing_mm = {SMOKE_SCOPE_SPACING_MM}
 
 [[grid]]
 segment = "straight"
