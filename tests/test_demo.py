@@ -12,6 +12,7 @@ import pytest
 
 from colonsim.catalog import SMOKE_ELEMENT_MM, SMOKE_SCOPE_SPACING_MM
 from colonsim.cli import main
+from colonsim.demo import REPLICATE_MESH
 
 
 @pytest.mark.slow
@@ -30,7 +31,7 @@ def test_demo_runs_every_workflow_and_writes_one_folder(tmp_path, capsys):
     assert len(table) == 12 and (table["status"] == "ok").all()
     assert set(table["diameter_mm"]) == {23.0, 36.0} and set(table["friction"]) == {0.0, 0.1}
     replicates = pd.read_parquet(out / "replicates" / "results.parquet")
-    assert len(replicates) == 4 and set(replicates["element_size_mm"]) == {round(0.93 * SMOKE_ELEMENT_MM, 3)}
+    assert len(replicates) == 4 and set(replicates["element_size_mm"]) == {round(REPLICATE_MESH * SMOKE_ELEMENT_MM, 3)}
     assert (out / "surrogate.json").is_file() and (out / "surrogate.npz").is_file()
     doc = json.loads((out / "surrogate.json").read_text())
     assert doc["segments"]["rsj"]["models"]["max_deformation_cm"]["scatter"]["pairs"] == 4
@@ -47,6 +48,7 @@ def test_demo_runs_every_workflow_and_writes_one_folder(tmp_path, capsys):
         means = [s["mean"] for s in rec["scopes"]]
         assert means == sorted(means)  # the ranking is by predicted deformation
     report = (out / "report.md").read_text()
-    assert f"{SMOKE_ELEMENT_MM:g} mm wall mesh with scope nodes every {SMOKE_SCOPE_SPACING_MM:g} mm" in report and "![RSJ insertions](insertion/comparison.png)" in report
+    assert f"{SMOKE_ELEMENT_MM:g} mm wall mesh with scope nodes every {SMOKE_SCOPE_SPACING_MM:g} mm" in report
+    assert "![RSJ insertions](insertion/comparison.png)" in report
     for figure in ("insertion/comparison.png", "surrogate_vs_diameter_mm.png", "surrogate_vs_friction.png"):
         assert (out / figure).stat().st_size > 10_000

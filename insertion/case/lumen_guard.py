@@ -58,5 +58,6 @@ def check_scope_inside(model, depth_m):
         case = model.case
         raise ColonsimError(
             f"the scope left the colon through its wall {depth_m * 100:.1f} cm into the push "
-            f"(scope node {inserted[k]} is {outside[k] * 1e3:.1f} mm beyond the wall): the {case.element_size_mm:g} mm wall "
-            f"mesh is too coarse for a {2e3 * model.rod.radius:.1f} mm scope; use a finer --element-size (the default is 3 mm)")
+            f"(scope node {inserted[k]} is {outside[k] * 1e3:.1f} mm beyond the wall): the "
+            f"{case.element_size_mm:g} mm wall mesh is too coarse for a {2e3 * model.rod.radius:.1f} mm scope; "
+            "use a finer --element-size (the default is 3 mm)")
