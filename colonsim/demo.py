@@ -2,8 +2,9 @@
 
 1. calibrate Mooney-Rivlin parameters from the bundled SYNTHETIC tensile curves (reduced budget);
 2. RSJ insertions of UTC, PDC and SDC (D = 36 mm, mu = 0) with the material just calibrated;
-3. a small sweep: RSJ x 3 scopes x D 23/36 mm x mu 0/0.1 (12 runs on local processes), and 4 of
-   its cases again on a finer mesh (the simulation's scatter);
+3. a small sweep: RSJ x 3 scopes x D 23/36 mm x mu 0/0.1 (12 runs on local processes, three of
+   which are step 2's runs, recorded rather than run again), and 4 of its cases again on a finer
+   mesh (the simulation's scatter);
 4. a surrogate fitted on that sweep, its noise floored at that scatter (leave-one-out
    cross-validation reported);
 5. a scope recommendation for two contrasting patients, by the largest colon deformation over the
@@ -92,13 +93,36 @@ def insertion_step(material: Path, element_size: float, scope_spacing: float, ou
     # other and a run takes up to 8x longer (measured: PDC 147 s instead of 17 s). `colonsim
     # insert --threads 2` is the faster choice on an idle machine.
     numba.set_num_threads(1)
-    cases = [InsertionCase(segment="rsj", scope=s, diameter_mm=36.0, material=str(material),
+    # the material named as the sweep names it, so that these three runs are cases of the sweep
+    cases = [InsertionCase(segment="rsj", scope=s, diameter_mm=36.0, material=material.resolve().as_posix(),
                            element_size_mm=element_size, scope_spacing_mm=scope_spacing)
              for s in ("utc", "pdc", "sdc")]
     return insert(cases, out, show=show)
 
 
-def sweep_step(material: Path, element_size: float, scope_spacing: float, out: Path, workers: int, show: bool):
+def record_step_runs(spec, insertions, out: Path) -> int:
+    """Record in the sweep folder ``out`` the runs of step 2 that are cases of the sweep (the same
+    key: the same inputs, material and mesh), so that the sweep does not run them again; return
+    how many were recorded."""
+    import datetime
+
+    from colonsim.insertion.study.sweep import SweepStore
+
+    cases = {c.key(): c for c in spec.cases}
+    now = datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds")
+    with SweepStore(out) as store:
+        store.check_same_sweep(cases, spec.source)
+        done = store.finished()
+        new = [r for r in insertions if r.case.key() in cases and r.case.key() not in done]
+        for r in new:
+            store.record(cases[r.case.key()], {"status": "ok", "summary": r.summary, "timeseries": r.timeseries,
+                                               "final_shape": r.final_shape, "wall_time_s": r.summary["wall_time_s"],
+                                               "finished_at": now})
+    return len(new)
+
+
+def sweep_step(material: Path, element_size: float, scope_spacing: float, out: Path, workers: int, show: bool,
+               insertions=()):
     from colonsim.insertion.study.sweep import run_sweep
     from colonsim.insertion.study.sweep_spec import parse_sweep
 
@@ -107,6 +131,9 @@ def sweep_step(material: Path, element_size: float, scope_spacing: float, out: P
     spec = parse_sweep(text, origin="demo sweep")
     _section(f"3/5 sweep: {spec.description.split(': ', 1)[1]} on {workers} local process"
              f"{'es' if workers > 1 else ''}")
+    reused = record_step_runs(spec, insertions, out)
+    if reused:
+        print(f"{reused} of its cases are the runs of step 2 (recorded, not run again)")
     report = run_sweep(spec.cases, out, workers=workers, spec=spec, progress=show)
     rate = f" ({report.runs_per_hour:.0f} runs/hour)" if report.ran else ""
     print(f"{report.skipped} already done, {report.ran} run in {report.wall_time_s:.0f} s{rate}: {report.ok} ok, "
@@ -271,7 +298,7 @@ def run_demo(options: DemoOptions):
     insertions = insertion_step(material, options.element_size_mm, scope_spacing, out / "insertion", show)
     seconds["insertions"] = time.perf_counter() - t
     t = time.perf_counter()
-    sweep = sweep_step(material, options.element_size_mm, scope_spacing, out / "sweep", workers, show)
+    sweep = sweep_step(material, options.element_size_mm, scope_spacing, out / "sweep", workers, show, insertions)
     seconds["sweep"] = time.perf_counter() - t
     t = time.perf_counter()
     model, _, _ = surrogate_step(out / "sweep" / "results.parquet", out / "replicates" / "results.parquet", out)

@@ -29,6 +29,12 @@ def test_demo_runs_every_workflow_and_writes_one_folder(tmp_path, capsys):
         assert (out / "insertion" / f"rsj_{scope}" / "timeseries.csv").is_file()
     table = pd.read_parquet(out / "sweep" / "results.parquet")
     assert len(table) == 12 and (table["status"] == "ok").all()
+    # step 2's runs are cases of the sweep: recorded there with their own numbers, not run again
+    assert "3 of its cases are the runs of step 2" in text
+    for scope in ("UTC", "PDC", "SDC"):
+        run = json.loads((out / "insertion" / f"rsj_{scope}" / "summary.json").read_text())
+        row = table[table["key"] == run["key"]]
+        assert len(row) == 1 and row["max_deformation_cm"].item() == run["max_deformation_cm"]
     assert set(table["diameter_mm"]) == {23.0, 36.0} and set(table["friction"]) == {0.0, 0.1}
     replicates = pd.read_parquet(out / "replicates" / "results.parquet")
     assert len(replicates) == 4 and set(replicates["element_size_mm"]) == {round(REPLICATE_MESH * SMOKE_ELEMENT_MM, 3)}
