@@ -32,3 +32,13 @@ def energy_gradient():
         return g
 
     return gradient
+
+
+@pytest.fixture
+def without_run_figures(monkeypatch):
+    """Sweeps of stand-in runs (a few synthetic samples each) write every run's files but its PNG:
+    drawing that figure was half the time of the adaptive-sweep tests (py-spy), which check the
+    loop, not the figure (test_insertion_straight.py and test_demo.py check the run figures)."""
+    from colonsim.insertion.case import results
+
+    monkeypatch.setattr(results, "save_figure", lambda fig, path, dpi=150: None)

@@ -27,6 +27,8 @@ from colonsim.insertion.study.sweep_spec import parse_sweep
 from colonsim.surrogate.acquisition import greedy_batch, trend_sd
 from colonsim.surrogate.gp import GaussianProcess
 
+pytestmark = pytest.mark.usefixtures("without_run_figures")
+
 TARGET = "final_deformation_cm"
 TOML = """
 [sweep]
