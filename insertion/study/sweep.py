@@ -205,7 +205,8 @@ def local_outcomes(cases, workers=2, runner=None):
     pending = list(cases)
     context = multiprocessing.get_context("spawn")
     while pending:
-        pool = ProcessPoolExecutor(max_workers=workers, mp_context=context, initializer=start_worker)
+        pool = ProcessPoolExecutor(max_workers=workers, mp_context=context, initializer=start_worker,
+                                   initargs=(runner is None,))
         in_flight = {}
         clean = False
         try:

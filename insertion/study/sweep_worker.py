@@ -38,11 +38,12 @@ def warm_up_case():
                          push_speed=5.0, ramp_s=0.01, record_interval_s=0.01)
 
 
-def prepare_worker():
+def prepare_worker(warm_up=True):
     """Process initializer: 1 Numba thread, kernels loaded (compiled, or read from the cache) once.
 
     Idempotent; :func:`execute` calls it too, so workers that join a Dask cluster later are
-    prepared by their first run (outside its timed part).
+    prepared by their first run (outside its timed part). ``warm_up`` False (the runs are a
+    stand-in runner's, which simulates nothing) skips the kernels.
     """
     global _PREPARED
     _one_thread()
@@ -51,6 +52,8 @@ def prepare_worker():
     # the sweep's own process has shown these once, when it checked the cases; a worker would
     # repeat them for every run, in the raw warnings format
     warnings.simplefilter("ignore", ColonsimWarning)
+    if not warm_up:
+        return
     with _RUN_LOCK:
         if _PREPARED:
             return
@@ -81,8 +84,9 @@ def exit_with_parent():
     threading.Thread(target=watch, name="exit-with-parent", daemon=True).start()
 
 
-def start_worker():
-    """Initializer of a local pool process (must not raise: the pool would break)."""
+def start_worker(warm_up=True):
+    """Initializer of a local pool process (must not raise: the pool would break); ``warm_up``:
+    see :func:`prepare_worker`."""
     import signal
 
     # Ctrl-C reaches the whole process group: the parent stops the sweep and says so in one line;
@@ -90,7 +94,7 @@ def start_worker():
     signal.signal(signal.SIGINT, lambda signum, frame: os._exit(130))
     exit_with_parent()
     try:
-        prepare_worker()
+        prepare_worker(warm_up)
     except (Exception, KeyboardInterrupt):  # the first run calls it again and records the error; Ctrl-C: quietly
         pass
 
@@ -117,7 +121,7 @@ def execute(case, runner=None) -> dict:
         ok runs ``summary``, ``timeseries`` (SI DataFrame) and ``final_shape`` (node positions at
         the end, or None), which the client writes.
     """
-    prepare_worker()
+    prepare_worker(warm_up=runner is None)
     _one_thread()
     runner = runner or default_runner
     with _RUN_LOCK:
