@@ -223,8 +223,8 @@ def test_cli_material_option_and_one_line_errors(fitted, tmp_path, capsys):
 
 @pytest.mark.slow
 def test_a_real_sweep_over_drawn_materials_end_to_end(tmp_path, capsys):
-    """RSJ at the smoke size (colonsim.catalog), 2 scopes x 2 posterior draws (about 50 s on one
-    core; the straight tube is not used: its scope never touches the wall, so every output is 0
+    """RSJ at the smoke size (colonsim.catalog), 2 scopes x 2 posterior draws (66 s under the README's
+    test command; the straight tube is not used: its scope never touches the wall, so every output is 0
     whatever the tissue)."""
     from colonsim.insertion.study.sweep import run_sweep
     from colonsim.insertion.study.sweep_spec import parse_sweep
