@@ -163,7 +163,8 @@ class ChildModel:
 
         self._positions = Path(tempfile.mkdtemp()) / "baseline_positions.npz"
         command = [str(args.baseline_python), __file__, "--serve", str(self._positions), "--mesh", str(args.mesh),
-                   "--rod-spacing", str(args.rod_spacing)] + (["--threads", str(args.threads)] if args.threads else [])
+                   "--rod-spacing", str(args.rod_spacing)] + (["--threads", str(args.threads)] if args.threads else []) \
+            + (["--devices"] if args.devices else [])  # the same model on both sides
         self._child = subprocess.Popen(command, stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True)
         if self._child.stdout.readline().strip() != "ready":
             sys.exit(f"--baseline-python {args.baseline_python}: the child did not start (see its error above)")

@@ -5,6 +5,9 @@ Plain functions of recorded arrays, so they apply equally to a fresh run and to 
 
 from __future__ import annotations
 
+import math
+
+import numba
 import numpy as np
 from scipy.signal import find_peaks
 
@@ -185,19 +188,33 @@ def sliding_kinetic_energy(x, v, mass, speed):
     return float(0.5 * np.sum(mass * np.einsum("ij,ij->i", rel, rel)))
 
 
+@numba.njit(cache=True)
 def principal_stretches(x, triangles, dm_inv):
     """Largest in-plane principal stretch of every triangle at positions ``x`` (n, 3), m.
 
     F = [x1 - x0, x2 - x0] Dm^-1 maps the reference plane into space (3 x 2); the stretches are
-    the square roots of the eigenvalues of C = F^T F (closed form for 2 x 2).
+    the square roots of the eigenvalues of C = F^T F (closed form for 2 x 2). Compiled: the
+    recorder measures every wall triangle at every sample, which in NumPy took about 6 % of a
+    run (RSF, 22,560 triangles: 1.7 ms against 0.17 ms a sample).
     """
-    p = x[triangles]
-    E = np.stack([p[:, 1] - p[:, 0], p[:, 2] - p[:, 0]], axis=2)  # (nt, 3, 2)
-    F = E @ dm_inv
-    C = np.einsum("tki,tkj->tij", F, F)
-    half_trace = 0.5 * (C[:, 0, 0] + C[:, 1, 1])
-    det = C[:, 0, 0] * C[:, 1, 1] - C[:, 0, 1] * C[:, 1, 0]
-    return np.sqrt(half_trace + np.sqrt(np.maximum(half_trace**2 - det, 0.0)))
+    out = np.empty(triangles.shape[0])
+    f = np.empty((3, 2))
+    for e in range(triangles.shape[0]):
+        i0 = triangles[e, 0]
+        i1 = triangles[e, 1]
+        i2 = triangles[e, 2]
+        for k in range(3):
+            e1 = x[i1, k] - x[i0, k]
+            e2 = x[i2, k] - x[i0, k]
+            f[k, 0] = e1 * dm_inv[e, 0, 0] + e2 * dm_inv[e, 1, 0]
+            f[k, 1] = e1 * dm_inv[e, 0, 1] + e2 * dm_inv[e, 1, 1]
+        c00 = f[0, 0] * f[0, 0] + f[1, 0] * f[1, 0] + f[2, 0] * f[2, 0]
+        c01 = f[0, 0] * f[0, 1] + f[1, 0] * f[1, 1] + f[2, 0] * f[2, 1]
+        c11 = f[0, 1] * f[0, 1] + f[1, 1] * f[1, 1] + f[2, 1] * f[2, 1]
+        half_trace = 0.5 * (c00 + c11)
+        det = c00 * c11 - c01 * c01
+        out[e] = math.sqrt(half_trace + math.sqrt(max(half_trace * half_trace - det, 0.0)))
+    return out
 
 
 JAM_PUSH = 0.02  # m of push over which the tip is watched

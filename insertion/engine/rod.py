@@ -123,6 +123,40 @@ def rod_kernel(x, rest_length, axial_k, bend_k, f):
 
 
 @numba.njit(cache=True)
+def stiffness_band(x, rest_length, axial_k, bend_k, eps, ab):
+    """The upper band of the tangent stiffness at ``x`` into ``ab`` (LAPACK upper banded storage:
+    ``ab[u + r - c, c] = K[r, c]`` for r <= c, u = ``ab.shape[0] - 1`` = 8), N/m.
+
+    Column by column from central differences of :func:`rod_kernel`'s forces with step ``eps`` (m),
+    perturbing every fifth node at once (their bands do not overlap): 15 pairs of evaluations.
+    """
+    n = x.shape[0]
+    u = ab.shape[0] - 1
+    xp = np.empty_like(x)
+    xm = np.empty_like(x)
+    fp = np.empty_like(x)
+    fm = np.empty_like(x)
+    for color in range(5):
+        for a in range(3):
+            xp[:, :] = x
+            xm[:, :] = x
+            for j in range(color, n, 5):
+                xp[j, a] += eps
+                xm[j, a] -= eps
+            fp[:, :] = 0.0
+            fm[:, :] = 0.0
+            rod_kernel(xp, rest_length, axial_k, bend_k, fp)
+            rod_kernel(xm, rest_length, axial_k, bend_k, fm)
+            for j in range(color, n, 5):
+                c = 3 * j + a
+                for i in range(max(j - 2, 0), j + 1):  # rows of nodes j - 2 .. j: the upper triangle
+                    for b in range(3):
+                        r = 3 * i + b
+                        if r <= c:
+                            ab[u + r - c, c] = -(fp[i, b] - fm[i, b]) / (2.0 * eps)
+
+
+@numba.njit(cache=True)
 def rod_omega2_kernel(x, rest_length, axial_k, bend_k, mass, out):
     """Gershgorin bound of each node's row of M^-1 K (rad^2/s^2) into ``out`` (n,).
 
@@ -300,39 +334,16 @@ class Rod:
     def max_frequency(self, x):
         """Largest angular frequency of the rod linearised at configuration x, rad/s.
 
-        The tangent stiffness is banded (a node couples to its two neighbours on each side), so
-        it is found column by column from central differences of the forces, perturbing every
-        fifth node at once (15 pairs of force evaluations), and the largest eigenvalue of
-        M^-1/2 K M^-1/2 comes from a banded symmetric eigensolver.
+        The tangent stiffness is banded (a node couples to its two neighbours on each side):
+        :func:`stiffness_band` finds it from central differences of the forces, and the largest
+        eigenvalue of M^-1/2 K M^-1/2 comes from a banded symmetric eigensolver.
         """
         self._check_x(x)
-        n = len(x)
-        ndof = 3 * n
+        ndof = 3 * len(x)
         u = 8  # upper bandwidth in DOFs: node i reaches node i + 2
         ab = np.zeros((u + 1, ndof))
         eps = 1e-6 * float(self.rest_length.min())
-        fp = np.zeros_like(x)
-        fm = np.zeros_like(x)
-        for color in range(5):
-            nodes = np.arange(color, n, 5)
-            for a in range(3):
-                xp = x.copy()
-                xm = x.copy()
-                xp[nodes, a] += eps
-                xm[nodes, a] -= eps
-                fp[:] = 0.0
-                fm[:] = 0.0
-                rod_kernel(xp, self.rest_length, self.axial_stiffness, self.bending_stiffness, fp)
-                rod_kernel(xm, self.rest_length, self.axial_stiffness, self.bending_stiffness, fm)
-                col = -(fp - fm) / (2.0 * eps)  # K[:, dof a of each perturbed node]
-                for o in range(-2, 1):  # rows of nodes j + o <= j: the upper triangle
-                    i = nodes + o
-                    ok = i >= 0
-                    for b in range(3):
-                        r = 3 * i[ok] + b
-                        c = 3 * nodes[ok] + a
-                        keep = r <= c
-                        ab[u + r[keep] - c[keep], c[keep]] = col[i[ok][keep], b]
+        stiffness_band(x, self.rest_length, self.axial_stiffness, self.bending_stiffness, eps, ab)
         d = np.repeat(1.0 / np.sqrt(self.mass), 3)
         for k in range(u + 1):
             off = u - k  # ab[k, c] holds K[c - off, c]

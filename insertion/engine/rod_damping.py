@@ -123,8 +123,10 @@ def damped_rod_velocity(x, v, f_int, f_con, f_ext, mass, alpha, alpha_lat, dashp
     n = x.shape[0]
     h = 0.5 * dt
     T = np.zeros((n - 1, 3, 3))
+    d = np.empty(3)
     for e in range(n - 1):
-        d = x[e + 1] - x[e]
+        for a in range(3):
+            d[a] = x[e + 1, a] - x[e, a]
         d /= np.sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2])
         for a in range(3):
             for b in range(3):
@@ -134,7 +136,8 @@ def damped_rod_velocity(x, v, f_int, f_con, f_ext, mass, alpha, alpha_lat, dashp
         for i in range(n):
             lo = max(i - 1, 0)
             hi = min(i + 1, n - 1)
-            d = x[hi] - x[lo]
+            for a in range(3):
+                d[a] = x[hi, a] - x[lo, a]
             d /= np.sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2])
             for a in range(3):
                 for b in range(3):
@@ -160,14 +163,20 @@ def damped_rod_velocity(x, v, f_int, f_con, f_ext, mass, alpha, alpha_lat, dashp
     A = np.zeros((3, 3))
     P = np.zeros((3, 3))
     M = np.zeros((3, 3))
+    # per-node scratch, allocated once (an allocation per node cost more than the solve)
+    r = np.zeros(3)
+    D = np.zeros((3, 3))
+    rhs = np.zeros(3)
+    B = np.zeros((3, 3))
+    z = np.zeros(3)
+    g = np.zeros(3)
     for i in range(n):
         m = mass[i]
         _projector(node_kind[i], node_dir[i], Qi)
         for a in range(3):
             for b in range(3):
                 P[a, b] = (1.0 if a == b else 0.0) - Qi[a, b]
-        r = np.zeros(3)
-        D = np.zeros((3, 3))
+        D[:, :] = 0.0
         for a in range(3):
             r[a] = m * (1.0 - h * alpha) * v[i, a] + dt * (f_int[i, a] + f_con[i, a] + f_ext[i, a]) + h * cv[i, a]
             D[a, a] = m * (1.0 + h * alpha)
@@ -181,7 +190,6 @@ def damped_rod_velocity(x, v, f_int, f_con, f_ext, mass, alpha, alpha_lat, dashp
             for a in range(3):
                 for b in range(3):
                     D[a, b] += h * T[i, a, b]
-        rhs = np.zeros(3)
         for a in range(3):
             s = 0.0
             for b in range(3):
@@ -200,7 +208,6 @@ def damped_rod_velocity(x, v, f_int, f_con, f_ext, mass, alpha, alpha_lat, dashp
                         acc -= P[a, k] * h * T[i, k, b]
                     upper[i, a, b] = acc
         if i > 0:  # B_i = (I - Q_i) L_i, L_i = -h T_{i-1}; eliminate v_{i-1}
-            B = np.zeros((3, 3))
             for a in range(3):
                 for b in range(3):
                     acc = 0.0
@@ -228,7 +235,6 @@ def damped_rod_velocity(x, v, f_int, f_con, f_ext, mass, alpha, alpha_lat, dashp
         for a in range(3):
             y[i, a] = rhs[a]
     for i in range(n - 1, -1, -1):
-        z = np.zeros(3)
         for a in range(3):
             z[a] = y[i, a]
             if i < n - 1:
@@ -253,7 +259,6 @@ def damped_rod_velocity(x, v, f_int, f_con, f_ext, mass, alpha, alpha_lat, dashp
             f_damp[e, a] += 0.5 * s
             f_damp[e + 1, a] -= 0.5 * s
     for i in range(n):
-        g = np.zeros(3)
         for a in range(3):
             g[a] = mass[i] * (v_new[i, a] - v[i, a]) / dt - (f_int[i, a] + f_con[i, a] + f_ext[i, a] + f_damp[i, a])
         _projector(node_kind[i], node_dir[i], Qi)
