@@ -17,6 +17,7 @@ from colonsim.files import os_failure
 from colonsim.input_ranges import check_input_range
 from colonsim.limits import MESH_MAX, POINTS_RANGE
 from colonsim.options import bounded_int, finite_float, output_folder, positive_int, seed, worker_count
+from colonsim.insertion.case.insertion_case import InsertionCase
 from colonsim.insertion.case.run_budget import DEFAULT_MAX_STEPS
 
 
@@ -125,9 +126,11 @@ def _add_insert(sub):
     p.add_argument("--angle", type=finite_float, default=0.0, help=f"degrees (default 0): {catalog.angle_help()}")
     p.add_argument("--friction", type=finite_float, default=0.0, help="Coulomb friction scope/wall (default 0)")
     p.add_argument("--wall-thickness", type=finite_float, default=2.0, help="colon wall thickness, mm (default 2, an assumption)")
-    p.add_argument("--element-size", type=finite_float, default=3.0, help="wall triangle size, mm (default 3)")
+    p.add_argument("--element-size", type=finite_float, default=InsertionCase.element_size_mm,
+                   help=f"wall triangle size, mm (default {InsertionCase.element_size_mm:g})")
     p.add_argument("--scope-spacing", type=finite_float, default=None,
-                   help="scope node spacing, mm (default 5; coarser is faster, not validated)")
+                   help=f"scope node spacing, mm (default {InsertionCase.scope_spacing_mm:g}; coarser is faster, not "
+                        "validated)")
     p.add_argument("--material", help="material JSON from colonsim calibrate (default: the source's parameters)")
     p.add_argument("--flexure-angle", type=finite_float, default=90.0,
                    help="turn of the splenic (RSF) or hepatic (THF) flexure, degrees (default 90, an assumption)")
@@ -208,11 +211,12 @@ def build_parser():
     cli_surrogate.add_parsers(sub)
     demo = sub.add_parser("demo", help="run the workflows on the bundled data (a few minutes on 2 cores)")
     demo.add_argument("--out", type=output_folder, default="colonsim_demo", help="output folder (default colonsim_demo)")
-    demo.add_argument("--element-size", type=finite_float, default=3.0,
-                      help="wall mesh of the insertions and the sweep, mm (default 3; coarser is faster, not validated)")
+    demo.add_argument("--element-size", type=finite_float, default=InsertionCase.element_size_mm,
+                      help=f"wall mesh of the insertions and the sweep, mm (default {InsertionCase.element_size_mm:g}; "
+                           "coarser is faster, not validated)")
     demo.add_argument("--scope-spacing", type=finite_float, default=None,
-                      help="scope node spacing of the insertions and the sweep, mm (default 5; coarser is faster, "
-                           "not validated)")
+                      help=f"scope node spacing of the insertions and the sweep, mm (default "
+                           f"{InsertionCase.scope_spacing_mm:g}; coarser is faster, not validated)")
     demo.add_argument("--workers", type=worker_count, default=None,
                       help="processes for the demo's sweep (default: up to 2 cores)")
     demo.add_argument("--no-progress", action="store_true", help="no progress bar")

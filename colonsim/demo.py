@@ -104,20 +104,17 @@ def record_step_runs(spec, insertions, out: Path) -> int:
     """Record in the sweep folder ``out`` the runs of step 2 that are cases of the sweep (the same
     key: the same inputs, material and mesh), so that the sweep does not run them again; return
     how many were recorded."""
-    import datetime
-
     from colonsim.insertion.study.sweep import SweepStore
+    from colonsim.insertion.study.sweep_worker import ok_outcome, utc_now
 
     cases = {c.key(): c for c in spec.cases}
-    now = datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds")
     with SweepStore(out) as store:
         store.check_same_sweep(cases, spec.source)
         done = store.finished()
         new = [r for r in insertions if r.case.key() in cases and r.case.key() not in done]
         for r in new:
-            store.record(cases[r.case.key()], {"status": "ok", "summary": r.summary, "timeseries": r.timeseries,
-                                               "final_shape": r.final_shape, "wall_time_s": r.summary["wall_time_s"],
-                                               "finished_at": now})
+            store.record(cases[r.case.key()], {**ok_outcome(r), "wall_time_s": r.summary["wall_time_s"],
+                                               "finished_at": utc_now()})
     return len(new)
 
 

@@ -25,7 +25,6 @@ seeded by the sweep's seed and the round).
 from __future__ import annotations
 
 import dataclasses
-import datetime
 import json
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -39,6 +38,7 @@ from colonsim.insertion.case.run_budget import DEFAULT_MAX_STEPS
 from colonsim.insertion.case.scenario import InsertionCase
 from colonsim.insertion.study.adaptive_design import AdaptiveDesign, input_matrix
 from colonsim.insertion.study.sweep import run_sweep
+from colonsim.insertion.study.sweep_worker import utc_now
 from colonsim.surrogate.acquisition import CRITERIA, greedy_batch
 from colonsim.surrogate.table import TARGET_LABELS, model_segment
 
@@ -122,10 +122,6 @@ class _Document:
     def document(self):
         return {**dataclasses.replace(self.spec, cases=self.cases).document(),
                 "adaptive": {"rounds": ROUNDS, "target": self.settings.target, "budget": self.settings.budget}}
-
-
-def _now():
-    return datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds")
 
 
 def read_rounds(folder, spec, settings) -> dict:
@@ -231,7 +227,7 @@ def run_adaptive_sweep(spec, out, settings: AdaptiveSettings, workers=2, schedul
             model, cv = fit_round(sweep.table, settings.target, spec.seed)
         except ColonsimError as exc:
             raise ColonsimError(f"adaptive sweep, round {current['round']}: {exc}") from None
-        current.update(cv=cv, runs=len(cases), ok=int((sweep.table["status"] == "ok").sum()), finished_at=_now())
+        current.update(cv=cv, runs=len(cases), ok=int((sweep.table["status"] == "ok").sum()), finished_at=utc_now())
         save_figure(rounds_figure(record, settings.target_rmse), out / FIGURE, dpi=120)
         open_segments = _open_segments(cv, settings.target_rmse)
         log(f"round {current['round']}: {len(current['chosen'])} run(s), {len(cases)} in all; LOO RMSE "
@@ -246,7 +242,7 @@ def run_adaptive_sweep(spec, out, settings: AdaptiveSettings, workers=2, schedul
             if not picks:
                 stopped = "no candidate left (every segment without a model, or the candidates all run)"
         if stopped:
-            record["stopped"] = {"reason": stopped, "runs": len(cases), "at": _now(),
+            record["stopped"] = {"reason": stopped, "runs": len(cases), "at": utc_now(),
                                  "target_rmse": settings.target_rmse, "budget": settings.budget}
             write_json(out / ROUNDS, record)
             break

@@ -40,7 +40,7 @@ from colonsim.scheduler_address import check_scheduler
 from colonsim.insertion.case.run_budget import DEFAULT_MAX_STEPS, check_sweep_budget
 from colonsim.insertion.case.scenario import InsertionResult
 from colonsim.insertion.study.sweep_rows import IDENTITY, OUTPUTS, input_columns, input_row, result_row
-from colonsim.insertion.study.sweep_worker import execute, start_worker
+from colonsim.insertion.study.sweep_worker import execute, start_worker, utc_now
 
 TABLE = "results.parquet"
 SWEEP_DOCUMENT = "sweep.json"
@@ -189,10 +189,7 @@ def _alive(lock: Path) -> bool:
 
 
 def _failed(case, message) -> dict:
-    import datetime
-
-    return {"key": case.key(), "status": "failed", "error": message, "wall_time_s": math.nan,
-            "finished_at": datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds")}
+    return {"key": case.key(), "status": "failed", "error": message, "wall_time_s": math.nan, "finished_at": utc_now()}
 
 
 def local_outcomes(cases, workers=2, runner=None):

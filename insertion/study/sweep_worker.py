@@ -30,6 +30,18 @@ def _one_thread():
     numba.set_num_threads(1)
 
 
+def utc_now() -> str:
+    """The current UTC time, ISO 8601 to the second (a results row's ``finished_at``)."""
+    return datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds")
+
+
+def ok_outcome(result) -> dict:
+    """The outcome fields of a run that finished (``result``: ``.summary``, ``.timeseries`` and an
+    optional ``.final_shape``), as the sweep's store records them."""
+    return {"status": "ok", "error": "", "summary": result.summary, "timeseries": result.timeseries,
+            "final_shape": getattr(result, "final_shape", None)}
+
+
 def warm_up_case():
     """A tiny insertion (coarse straight tube, fast push) that touches every kernel once."""
     from colonsim.insertion.case.scenario import InsertionCase
@@ -127,12 +139,9 @@ def execute(case, runner=None) -> dict:
     with _RUN_LOCK:
         t0 = time.perf_counter()
         try:
-            result = runner(case)
-            outcome = {"status": "ok", "error": "", "summary": result.summary, "timeseries": result.timeseries,
-                       "final_shape": getattr(result, "final_shape", None)}
+            outcome = ok_outcome(runner(case))
         except Exception as exc:  # a failed run is a result too; the sweep goes on
             message = " ".join(str(exc).split()) or "(no message)"
             outcome = {"status": "failed", "error": f"{type(exc).__name__}: {message}"}
         wall = time.perf_counter() - t0
-    return {"key": case.key(), "wall_time_s": wall,
-            "finished_at": datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds"), **outcome}
+    return {"key": case.key(), "wall_time_s": wall, "finished_at": utc_now(), **outcome}
