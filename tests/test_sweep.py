@@ -10,13 +10,15 @@ import signal
 import subprocess
 import sys
 import time
+import types
 from pathlib import Path
 
 import pandas as pd
 import pytest
 
 from colonsim.insertion.case.scenario import InsertionCase, run_insertion
-from colonsim.insertion.study.sweep import DIED, IDENTITY, OUTPUTS, TABLE, SweepStore, result_row, run_sweep
+from colonsim.insertion.study.sweep import (DIED, IDENTITY, OUTPUTS, TABLE, LocalPool, SweepStore, local_outcomes,
+                                            result_row, run_sweep)
 from colonsim.insertion.study.sweep_spec import load_sweep
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -35,6 +37,13 @@ def failing_runner(case):
     if case.scope == "utc":
         os._exit(3)
     return run_insertion(case)
+
+
+def pid_runner(case):
+    """SYNTHETIC run: no simulation, the worker process's id as its outcome; RSJ UTC -> the worker dies."""
+    if case.scope == "utc":
+        os._exit(3)
+    return types.SimpleNamespace(summary={"pid": os.getpid()}, timeseries=None)
 
 
 def check_ok_rows(folder, table):
@@ -160,6 +169,26 @@ def test_failed_runs_are_recorded_and_do_not_stop_the_others(tmp_path):
         assert not (out / "runs" / r["key"]).exists()
     # failed runs count as finished unless asked to retry them (the store test checks the retry set)
     assert run_sweep(SMOKE, out, workers=1, progress=False).ran == 0
+
+
+def test_a_local_pool_serves_several_sweeps_and_replaces_a_broken_one():
+    """The rounds of an adaptive sweep share their worker processes; a worker that dies costs its
+    run, and the next sweep gets fresh processes."""
+    dies = next(c for c in SMOKE if c.scope == "utc")
+    others = [c for c in SMOKE if c.scope != "utc"]
+
+    def pids(cases, pool):
+        outcomes = [o for _, o in local_outcomes(cases, 2, pid_runner, pool)]
+        return {o["summary"]["pid"] if o["status"] == "ok" else o["error"] for o in outcomes}
+
+    with LocalPool(2, warm_up=False) as pool:
+        first = pids(others, pool)
+        alive = set(pool.executor()._processes)
+        assert first <= alive and pids(others, pool) <= alive  # the same processes, not new ones
+        assert pids([dies], pool) == {DIED}
+        after = pids(others[:1], pool)
+        assert len(after) == 1 and not after & alive  # a fresh pool
+    assert pool._executor is None  # closed on leaving the block
 
 
 def test_store_rows_follow_the_contract_and_the_table_is_replaced_atomically(tmp_path):

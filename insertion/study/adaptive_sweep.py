@@ -24,6 +24,7 @@ seeded by the sweep's seed and the round).
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import json
 from dataclasses import dataclass, field
@@ -37,7 +38,7 @@ from colonsim.files import check_output_folder, save_figure, write_json
 from colonsim.insertion.case.run_budget import DEFAULT_MAX_STEPS
 from colonsim.insertion.case.scenario import InsertionCase
 from colonsim.insertion.study.adaptive_design import AdaptiveDesign, input_matrix
-from colonsim.insertion.study.sweep import run_sweep
+from colonsim.insertion.study.sweep import LocalPool, run_sweep
 from colonsim.insertion.study.sweep_worker import utc_now
 from colonsim.surrogate.acquisition import CRITERIA, greedy_batch
 from colonsim.surrogate.table import TARGET_LABELS, model_segment
@@ -216,43 +217,45 @@ def run_adaptive_sweep(spec, out, settings: AdaptiveSettings, workers=2, schedul
                                           "with its grid", "chosen": [_pick_record(design, c) for c in design.first_round]})
     cases = {r["key"]: _case(r) for rnd in rounds for r in rnd["chosen"]}
     ran, stopped = 0, ""
-    while True:
-        sweep = run_sweep(list(cases.values()), out, workers=workers, scheduler=scheduler, runner=runner,
-                          retry_failed=retry_failed, spec=_Document(spec, list(cases.values()), settings),
-                          progress=progress, log=log, max_steps=max_steps)
-        ran += sweep.ran
-        retry_failed = False  # retried once, in the first call
-        current = rounds[-1]
-        try:
-            model, cv = fit_round(sweep.table, settings.target, spec.seed)
-        except ColonsimError as exc:
-            raise ColonsimError(f"adaptive sweep, round {current['round']}: {exc}") from None
-        current.update(cv=cv, runs=len(cases), ok=int((sweep.table["status"] == "ok").sum()), finished_at=utc_now())
-        save_figure(rounds_figure(record, settings.target_rmse), out / FIGURE, dpi=120)
-        open_segments = _open_segments(cv, settings.target_rmse)
-        log(f"round {current['round']}: {len(current['chosen'])} run(s), {len(cases)} in all; LOO RMSE "
-            + ", ".join(f"{s} {m['rmse']:.3g}" if "rmse" in m else f"{s} no model" for s, m in cv.items()))
-        if settings.target_rmse is not None and not open_segments and all("rmse" in m for m in cv.values()):
-            stopped = "target reached"
-        elif len(cases) >= settings.budget:
-            stopped = "budget reached"
-        if not stopped:
-            picks = choose_batch(design, model, settings.target, open_segments, current["round"] + 1, cases,
-                                 min(settings.batch, settings.budget - len(cases)), settings.criterion)
-            if not picks:
-                stopped = "no candidate left (every segment without a model, or the candidates all run)"
-        if stopped:
-            record["stopped"] = {"reason": stopped, "runs": len(cases), "at": utc_now(),
-                                 "target_rmse": settings.target_rmse, "budget": settings.budget}
-            write_json(out / ROUNDS, record)
-            break
-        rounds.append({"round": current["round"] + 1, "why": WHY[settings.criterion], "criterion": settings.criterion,
-                       "batch": settings.batch,
-                       "target_rmse": settings.target_rmse,
-                       "chosen": [_pick_record(design, case, pick) for case, pick in picks]})
-        record.pop("stopped", None)
-        write_json(out / ROUNDS, record)  # the choice first: a sweep killed during the batch reruns the same batch
-        cases.update((case.key(), case) for case, _ in picks)
+    # local workers kept across the rounds: spawned, and their kernels loaded, once
+    with LocalPool(workers, warm_up=runner is None) if scheduler is None else contextlib.nullcontext() as pool:
+        while True:
+            sweep = run_sweep(list(cases.values()), out, workers=workers, scheduler=scheduler, runner=runner,
+                              retry_failed=retry_failed, spec=_Document(spec, list(cases.values()), settings),
+                              progress=progress, log=log, max_steps=max_steps, pool=pool)
+            ran += sweep.ran
+            retry_failed = False  # retried once, in the first call
+            current = rounds[-1]
+            try:
+                model, cv = fit_round(sweep.table, settings.target, spec.seed)
+            except ColonsimError as exc:
+                raise ColonsimError(f"adaptive sweep, round {current['round']}: {exc}") from None
+            current.update(cv=cv, runs=len(cases), ok=int((sweep.table["status"] == "ok").sum()),
+                           finished_at=utc_now())
+            save_figure(rounds_figure(record, settings.target_rmse), out / FIGURE, dpi=120)
+            open_segments = _open_segments(cv, settings.target_rmse)
+            log(f"round {current['round']}: {len(current['chosen'])} run(s), {len(cases)} in all; LOO RMSE "
+                + ", ".join(f"{s} {m['rmse']:.3g}" if "rmse" in m else f"{s} no model" for s, m in cv.items()))
+            if settings.target_rmse is not None and not open_segments and all("rmse" in m for m in cv.values()):
+                stopped = "target reached"
+            elif len(cases) >= settings.budget:
+                stopped = "budget reached"
+            if not stopped:
+                picks = choose_batch(design, model, settings.target, open_segments, current["round"] + 1, cases,
+                                     min(settings.batch, settings.budget - len(cases)), settings.criterion)
+                if not picks:
+                    stopped = "no candidate left (every segment without a model, or the candidates all run)"
+            if stopped:
+                record["stopped"] = {"reason": stopped, "runs": len(cases), "at": utc_now(),
+                                     "target_rmse": settings.target_rmse, "budget": settings.budget}
+                write_json(out / ROUNDS, record)
+                break
+            rounds.append({"round": current["round"] + 1, "why": WHY[settings.criterion],
+                           "criterion": settings.criterion, "batch": settings.batch, "target_rmse": settings.target_rmse,
+                           "chosen": [_pick_record(design, case, pick) for case, pick in picks]})
+            record.pop("stopped", None)
+            write_json(out / ROUNDS, record)  # the choice first: a sweep killed during the batch reruns the same batch
+            cases.update((case.key(), case) for case, _ in picks)
     return AdaptiveReport(out, rounds, stopped, len(cases), ran, sweep.table)
 
 

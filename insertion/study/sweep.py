@@ -192,25 +192,64 @@ def _failed(case, message) -> dict:
     return {"key": case.key(), "status": "failed", "error": message, "wall_time_s": math.nan, "finished_at": utc_now()}
 
 
-def local_outcomes(cases, workers=2, runner=None):
+class LocalPool:
+    """Local worker processes that several sweeps can share (the rounds of an adaptive sweep), so
+    each round does not spawn its workers and load their kernels again.
+
+    Workers are spawned (not forked: the parent may hold Numba threads) with one Numba thread
+    each, when first needed; a pool broken by a dying worker is replaced by a fresh one. Use it
+    as a context manager, or call :meth:`close`.
+    """
+
+    def __init__(self, workers, warm_up=True):
+        self.workers = int(workers)
+        self.warm_up = bool(warm_up)
+        self._executor = None
+
+    def executor(self):
+        if self._executor is None:
+            self._executor = ProcessPoolExecutor(max_workers=self.workers, mp_context=multiprocessing.get_context(
+                "spawn"), initializer=start_worker, initargs=(self.warm_up,))
+        return self._executor
+
+    def discard(self, wait=False):
+        """Shut the current processes down (``wait``: let them finish); the next use starts new ones."""
+        if self._executor is not None:
+            self._executor.shutdown(wait=wait, cancel_futures=True)
+            self._executor = None
+
+    def close(self):
+        self.discard(wait=True)
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.discard(wait=exc[0] is None)
+
+
+def local_outcomes(cases, workers=2, runner=None, pool=None):
     """Run ``cases`` in a local process pool; yield ``(case, outcome)`` as runs finish.
 
     At most ``workers`` runs are in flight, so a worker that dies (killed, out of memory) costs
-    only the runs it had: they are reported failed and a fresh pool takes the rest. Workers are
-    spawned (not forked: the parent may hold Numba threads) with one Numba thread each.
+    only the runs it had: they are reported failed and a fresh pool takes the rest. ``pool``: a
+    :class:`LocalPool` to run on and leave open (None: one of ``workers`` processes for these
+    cases only).
     """
     pending = list(cases)
-    context = multiprocessing.get_context("spawn")
+    own = pool is None
+    if own:
+        pool = LocalPool(workers, warm_up=runner is None)
+    workers = min(workers, pool.workers)
     while pending:
-        pool = ProcessPoolExecutor(max_workers=workers, mp_context=context, initializer=start_worker,
-                                   initargs=(runner is None,))
+        executor = pool.executor()
         in_flight = {}
         clean = False
         try:
             while pending or in_flight:
                 while pending and len(in_flight) < workers:
                     case = pending.pop(0)
-                    in_flight[pool.submit(execute, case, runner)] = case
+                    in_flight[executor.submit(execute, case, runner)] = case
                 done, _ = wait(in_flight, return_when=FIRST_COMPLETED)
                 broken = False
                 for future in done:
@@ -227,10 +266,12 @@ def local_outcomes(cases, workers=2, runner=None):
                     for future, case in in_flight.items():
                         yield case, _failed(case, DIED)
                     in_flight.clear()
+                    pool.discard()
                     break
             clean = True
         finally:
-            pool.shutdown(wait=clean, cancel_futures=True)
+            if own or not clean:  # a shared pool stays open unless the sweep was stopped
+                pool.discard(wait=clean)
 
 
 def dask_outcomes(cases, address, runner=None, log=print):
@@ -306,7 +347,7 @@ class SweepReport:
 
 
 def run_sweep(cases, out, workers=2, scheduler=None, runner=None, retry_failed=False, spec=None,
-              progress=True, log=print, max_steps=DEFAULT_MAX_STEPS) -> SweepReport:
+              progress=True, log=print, max_steps=DEFAULT_MAX_STEPS, pool=None) -> SweepReport:
     """Run every case of a sweep not yet finished in ``out``; record each run as it finishes.
 
     Parameters
@@ -329,6 +370,9 @@ def run_sweep(cases, out, workers=2, scheduler=None, runner=None, retry_failed=F
     max_steps : int
         Refuse the sweep if a run of one of its materials needs more time steps
         (:func:`colonsim.insertion.case.run_budget.check_sweep_budget`).
+    pool : LocalPool or None
+        Local worker processes to run on and leave open (several sweeps in a row); None: the
+        sweep starts its own.
     """
     if workers < 1:
         raise ColonsimError(f"workers = {workers}; give at least 1 worker process")
@@ -353,7 +397,7 @@ def run_sweep(cases, out, workers=2, scheduler=None, runner=None, retry_failed=F
         outcomes = None
         if todo:  # a Dask client connects here: an unreachable scheduler fails before sweep.json is written
             outcomes = (dask_outcomes(todo, scheduler, runner, log) if scheduler
-                        else local_outcomes(todo, min(workers, len(todo)), runner))
+                        else local_outcomes(todo, min(workers, len(todo)), runner, pool))
         write_json(out / SWEEP_DOCUMENT, spec.document() if spec is not None else
                    {"name": None, "runs": len(cases), "keys": [c.key() for c in cases]})
         if outcomes is not None:
@@ -392,5 +436,5 @@ def describe_cases(cases) -> str:
     return frame[["key", *varying]].to_string(index=False)
 
 
-__all__ = ["SweepStore", "SweepReport", "run_sweep", "local_outcomes", "dask_outcomes", "read_results",
+__all__ = ["LocalPool", "SweepStore", "SweepReport", "run_sweep", "local_outcomes", "dask_outcomes", "read_results",
            "result_row", "input_row", "describe_cases", "IDENTITY", "OUTPUTS", "TABLE"]
