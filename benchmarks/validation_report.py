@@ -94,6 +94,20 @@ def flexure_models(main, out):
     return {"rows": sections.public(rows), "figures": figs}
 
 
+def resistance_section(sweep, out):
+    """The distal resistance section, with the final shapes at 10 N per RSF/THF angle."""
+    section = resistance.resistance_section(sweep)
+    if section["ran"]:
+        speed = InsertionCase().push_speed
+        for segment in ("rsf", "thf"):
+            entries = [(c, sweep) for c in sweep.cases if c.segment == segment and c.distal_resistance_N == 10.0
+                       and math.isclose(c.push_speed, speed)]
+            fig = shape_figure(entries, f"figures/{segment}_shapes_10N.png",
+                               f"{segment.upper()}, 10 N distal resistance: final shapes per angle", out)
+            section["figures"] += [fig] if fig else []
+    return section
+
+
 def not_run_note(validation):
     if validation.folder is None:
         return ("no --validation-sweep given; run `colonsim sweep --preset validation --out DIR` and pass "
@@ -209,7 +223,7 @@ def main(argv=None):
                           "figure": "figures/smoothness.png",
                           "surrogate": smoothness.surrogate_holdout(gp_train, gp_test)},
            "flexure_sensitivity": sensitivity,
-           "resistance": resistance.resistance_section(resisted),
+           "resistance": resistance_section(resisted, out),
            "node_counts": sections.node_counts(),
            "run_ends": {"main": sections.run_ends(main_sweep), "validation": sections.run_ends(validation)},
            "run_times": {"rows": times, "summary": sections.run_time_summary(times)}, "figures": figs}

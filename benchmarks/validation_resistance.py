@@ -17,6 +17,7 @@ import numpy as np
 
 from colonsim.insertion.case.insertion_case import InsertionCase
 from colonsim.insertion.case.outcomes import RINGING_LIMIT
+from colonsim.insertion.study.claims import evaluate_claims
 from colonsim.markdown import md_table, num
 from validation_sweeps import role, scope_label
 
@@ -61,7 +62,25 @@ def resistance_section(sweep) -> dict:
                      "ended_by": str(row.get("ended_by", ""))})
     return {"ran": True, "rows": rows, "missing": missing, "differences": _differences(rows),
             "rsj": [r for r in rows if r["segment"] == "rsj"], "rate": _rate_pairs(sweep, speed),
-            "quasi_static": _quasi_static(rows)}
+            "quasi_static": _quasi_static(rows), "claims": claims_per_level(sweep, speed), "figures": []}
+
+
+def claims_per_level(sweep, speed) -> list:
+    """The source's claims on the runs of each level at the default push speed (the preset's RSJ
+    runs are at mu = 0, so the RSJ claims compare the scopes there and the friction claim cannot be
+    evaluated). One row per claim: its verdict and reason at every level."""
+    table = sweep.table
+    at_speed = table[np.isclose(table["push_speed"].astype(float), speed)]
+    rows = {}
+    for level in LEVELS_N:
+        subset = at_speed[np.isclose(at_speed["distal_resistance_N"].astype(float), level)]
+        if subset.empty:
+            continue
+        for claim in evaluate_claims(subset, frictions=(0.0,)):
+            row = rows.setdefault(claim.name, {"name": claim.name, "statement": claim.statement, "levels": {}})
+            row["levels"][f"{level:g}"] = {"verdict": claim.verdict, "reason": claim.reason,
+                                           "missing": len(claim.missing)}
+    return list(rows.values())
 
 
 def _differences(rows) -> list:
@@ -117,6 +136,15 @@ def _rate_pairs(sweep, speed) -> list:
     return out
 
 
+def _verdict_cell(entry):
+    if entry is None:
+        return "-"
+    if entry["missing"]:
+        return f"{entry['verdict']} ({entry['missing']} runs missing)"
+    reason = " ".join(entry["reason"].split())  # one table cell
+    return entry["verdict"] + (f": {reason}" if reason else "")
+
+
 def markdown(section) -> list:
     """The section's Markdown lines."""
     lines = ["## 14. Distal resistance", "",
@@ -148,6 +176,14 @@ def markdown(section) -> list:
                                  ("A", "point_A_cm"), ("B", "point_B_cm"), ("C", "point_C_cm"),
                                  ("C > A", lambda r: "-" if r["point_A_cm"] is None or r["point_C_cm"] is None
                                   else ("yes" if r["point_C_cm"] > r["point_A_cm"] else "no"))]), ""]
+    if section["claims"]:
+        lines += ["The source's claims at every level (RSJ at mu = 0: the friction claim needs runs the preset "
+                  "does not have):", "",
+                  md_table(section["claims"], [("claim", "statement")] + [
+                      (f"{level:g} N", (lambda r, k=f"{level:g}": _verdict_cell(r["levels"].get(k))))
+                      for level in LEVELS_N]), ""]
+    for fig in section["figures"]:
+        lines += [f"![{fig['title']}]({fig['file']})", ""]
     diffs = section["differences"]
     if diffs:
         lines += ["Laid out like the source (final deformation differences, cm; negative: the thinner scope deforms "

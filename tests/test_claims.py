@@ -167,3 +167,15 @@ def test_advantage_floor():
     assert advantage(0.5 * NO_DEFORMATION_CM, 0.0) == 0.0  # nothing measurable
     # only the small scope deforms the colon: negative, scaled by the floor
     assert advantage(0.0, 2.0 * NO_DEFORMATION_CM) == pytest.approx(-2.0)
+
+
+def test_a_sweep_at_mu_0_only_is_judged_at_mu_0_when_told_so():
+    """The resistance preset runs the RSJ at mu = 0 only: with ``frictions=(0.0,)`` the scope
+    comparisons are judged there, while the friction claim still says what it lacks."""
+    at_zero = rsj_table().query("friction == 0.0")
+    default, told = evaluate_claims(at_zero), evaluate_claims(at_zero, frictions=(0.0,))
+    assert [c.verdict for c in default[:3]] == [NOT_EVALUATED] * 3
+    assert [c.verdict for c in told[:3]] == [REPRODUCED, REPRODUCED, NOT_EVALUATED]
+    assert len(told[0].evidence) == 4  # 2 small-caliber scopes x 2 diameters
+    worse = replace(at_zero, "utc", 36, 0.0, final_deformation_cm=5.0)
+    assert evaluate_claims(worse, frictions=(0.0,))[0].verdict == NOT_REPRODUCED

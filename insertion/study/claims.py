@@ -284,10 +284,12 @@ def rsj_ordering(table, diameters=RSJ_DIAMETERS, friction=0.0) -> ClaimResult:
     return _verdict(result, runs, failures)
 
 
-def evaluate_claims(table) -> list[ClaimResult]:
-    """Every claim of the source, in the order it states them."""
-    return [sc_deform_less_rsj(table), reduction_larger_at_small_diameter(table), sc_less_friction_sensitive(table),
-            angle_dependence(table, "rsf"), angle_dependence(table, "thf"), rsj_ordering(table)]
+def evaluate_claims(table, frictions=FRICTIONS) -> list[ClaimResult]:
+    """Every claim of the source, in the order it states them; ``frictions``: the RSJ frictions
+    the first two claims compare the scopes at (a sweep at mu = 0 only: ``(0.0,)``)."""
+    return [sc_deform_less_rsj(table, frictions=frictions), reduction_larger_at_small_diameter(table, frictions=frictions),
+            sc_less_friction_sensitive(table), angle_dependence(table, "rsf"), angle_dependence(table, "thf"),
+            rsj_ordering(table)]
 
 
 def _list(values, unit=""):
