@@ -106,7 +106,8 @@ def cmd_sweep(args):
         check_scheduler(args.scheduler)
     from colonsim.insertion.case.run_budget import check_sweep_budget
     from colonsim.insertion.study.adaptive_sweep import ROUNDS
-    from colonsim.insertion.study.sweep import SweepStore, dask_distributed, describe_cases, run_sweep
+    from colonsim.insertion.study.sweep import SweepStore, describe_cases, run_sweep
+    from colonsim.insertion.study.sweep_outcomes import dask_distributed
     from colonsim.insertion.study.sweep_spec import load_sweep
 
     if args.scheduler is not None and not args.dry_run:

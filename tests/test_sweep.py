@@ -17,8 +17,8 @@ import pandas as pd
 import pytest
 
 from colonsim.insertion.case.scenario import InsertionCase, run_insertion
-from colonsim.insertion.study.sweep import (DIED, IDENTITY, OUTPUTS, TABLE, LocalPool, SweepStore, local_outcomes,
-                                            result_row, run_sweep)
+from colonsim.insertion.study.sweep import IDENTITY, OUTPUTS, TABLE, SweepStore, result_row, run_sweep
+from colonsim.insertion.study.sweep_outcomes import DIED, LocalPool, local_outcomes
 from colonsim.insertion.study.sweep_spec import load_sweep
 
 ROOT = Path(__file__).resolve().parents[1]

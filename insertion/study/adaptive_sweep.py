@@ -38,7 +38,8 @@ from colonsim.files import check_output_folder, save_figure, write_json
 from colonsim.insertion.case.run_budget import DEFAULT_MAX_STEPS
 from colonsim.insertion.case.scenario import InsertionCase
 from colonsim.insertion.study.adaptive_design import AdaptiveDesign, input_matrix
-from colonsim.insertion.study.sweep import LocalPool, run_sweep
+from colonsim.insertion.study.sweep import run_sweep
+from colonsim.insertion.study.sweep_outcomes import LocalPool
 from colonsim.insertion.study.sweep_worker import utc_now
 from colonsim.surrogate.acquisition import CRITERIA, greedy_batch
 from colonsim.surrogate.table import TARGET_LABELS, model_segment

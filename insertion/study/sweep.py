@@ -13,20 +13,16 @@ that were in flight; failed runs are recorded with their error (rerun them with
 ``retry_failed=True``) and never stop the others. A folder holds one sweep: another sweep (other
 cases) written into it is refused, so that one table never mixes two sweeps.
 
-Runs go to a local process pool (:func:`local_outcomes`) or an existing Dask distributed cluster
-(:func:`dask_outcomes`); both yield outcomes as runs finish, and only this process writes files:
+Runs go to a local process pool or an existing Dask distributed cluster
+(:mod:`colonsim.insertion.study.sweep_outcomes`); both yield outcomes as runs finish, and only this process writes files:
 Dask workers need the package, and the material and centerline files the cases name at their paths.
 """
 
 from __future__ import annotations
 
 import math
-import multiprocessing
 import os
 import time
-import uuid
-from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
-from concurrent.futures.process import BrokenProcessPool
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -34,18 +30,15 @@ import pandas as pd
 
 from colonsim.errors import ColonsimError
 from colonsim.files import atomic_path, check_entries, check_output_folder, output_set, write_json
-from colonsim.limits import SCHEDULER_CHECK_S
 from colonsim.provenance import code_version
-from colonsim.scheduler_address import check_scheduler
 from colonsim.insertion.case.run_budget import DEFAULT_MAX_STEPS, check_sweep_budget
 from colonsim.insertion.case.scenario import InsertionResult
+from colonsim.insertion.study.sweep_outcomes import dask_distributed, dask_outcomes, local_outcomes
 from colonsim.insertion.study.sweep_rows import IDENTITY, OUTPUTS, input_columns, input_row, result_row
-from colonsim.insertion.study.sweep_worker import execute, start_worker, utc_now
 
 TABLE = "results.parquet"
 SWEEP_DOCUMENT = "sweep.json"
 LOCK = ".sweep.lock"
-DIED = "worker process died during this run (killed or out of memory)"
 class SweepStore:
     """The results of a sweep folder: read at start, one row added (atomically) per finished run.
 
@@ -188,146 +181,6 @@ def _alive(lock: Path) -> bool:
     return pid != os.getpid()
 
 
-def _failed(case, message) -> dict:
-    return {"key": case.key(), "status": "failed", "error": message, "wall_time_s": math.nan, "finished_at": utc_now()}
-
-
-class LocalPool:
-    """Local worker processes that several sweeps can share (the rounds of an adaptive sweep), so
-    each round does not spawn its workers and load their kernels again.
-
-    Workers are spawned (not forked: the parent may hold Numba threads) with one Numba thread
-    each, when first needed; a pool broken by a dying worker is replaced by a fresh one. Use it
-    as a context manager, or call :meth:`close`.
-    """
-
-    def __init__(self, workers, warm_up=True):
-        self.workers = int(workers)
-        self.warm_up = bool(warm_up)
-        self._executor = None
-
-    def executor(self):
-        if self._executor is None:
-            self._executor = ProcessPoolExecutor(max_workers=self.workers, mp_context=multiprocessing.get_context(
-                "spawn"), initializer=start_worker, initargs=(self.warm_up,))
-        return self._executor
-
-    def discard(self, wait=False):
-        """Shut the current processes down (``wait``: let them finish); the next use starts new ones."""
-        if self._executor is not None:
-            self._executor.shutdown(wait=wait, cancel_futures=True)
-            self._executor = None
-
-    def close(self):
-        self.discard(wait=True)
-
-    def __enter__(self):
-        return self
-
-    def __exit__(self, *exc):
-        self.discard(wait=exc[0] is None)
-
-
-def local_outcomes(cases, workers=2, runner=None, pool=None):
-    """Run ``cases`` in a local process pool; yield ``(case, outcome)`` as runs finish.
-
-    At most ``workers`` runs are in flight, so a worker that dies (killed, out of memory) costs
-    only the runs it had: they are reported failed and a fresh pool takes the rest. ``pool``: a
-    :class:`LocalPool` to run on and leave open (None: one of ``workers`` processes for these
-    cases only).
-    """
-    pending = list(cases)
-    own = pool is None
-    if own:
-        pool = LocalPool(workers, warm_up=runner is None)
-    workers = min(workers, pool.workers)
-    while pending:
-        executor = pool.executor()
-        in_flight = {}
-        clean = False
-        try:
-            while pending or in_flight:
-                while pending and len(in_flight) < workers:
-                    case = pending.pop(0)
-                    in_flight[executor.submit(execute, case, runner)] = case
-                done, _ = wait(in_flight, return_when=FIRST_COMPLETED)
-                broken = False
-                for future in done:
-                    case = in_flight.pop(future)
-                    try:
-                        outcome = future.result()
-                    except BrokenProcessPool:
-                        broken = True
-                        outcome = _failed(case, DIED)
-                    except Exception as exc:  # e.g. an outcome that could not be sent back
-                        outcome = _failed(case, f"{type(exc).__name__}: {' '.join(str(exc).split())}")
-                    yield case, outcome
-                if broken:
-                    for future, case in in_flight.items():
-                        yield case, _failed(case, DIED)
-                    in_flight.clear()
-                    pool.discard()
-                    break
-            clean = True
-        finally:
-            if own or not clean:  # a shared pool stays open unless the sweep was stopped
-                pool.discard(wait=clean)
-
-
-def dask_outcomes(cases, address, runner=None, log=print):
-    """Send ``cases`` to the Dask distributed scheduler at ``address``; yield ``(case, outcome)``.
-
-    Workers should run one task at a time (``dask worker ADDR --nthreads 1``, one worker per
-    core): runs within a worker process are serialized anyway. Each worker loads the kernels
-    once, at its first run (outside the timed part), which also covers workers that join late.
-    """
-    Client = dask_distributed().Client
-    check_scheduler(address)  # an unroutable address or another server fails here, in seconds and one line
-    try:  # connect now, so an unreachable scheduler fails before anything is written
-        client = Client(address, timeout=f"{SCHEDULER_CHECK_S:g}s", set_as_default=False)
-    except Exception as exc:  # OSError, TimeoutError, a handshake distributed could not read, ...
-        raise ColonsimError(f"cannot reach the Dask scheduler at {address} ({type(exc).__name__}: "
-                            f"{' '.join(str(exc).split())[:200]}); start one with `dask scheduler` and workers with "
-                            f"`dask worker {address} --nthreads 1`") from None
-    return _dask_stream(client, cases, address, runner, log)
-
-
-def dask_distributed():
-    """The ``distributed`` package (the ``cluster`` extra), or a one-line error naming the fix."""
-    try:
-        import distributed
-    except ImportError as exc:
-        raise ColonsimError(f'running on a Dask cluster (--scheduler) needs dask ({exc}); '
-                            'pip install "colonsim[cluster]"') from None
-    return distributed
-
-
-def _dask_stream(client, cases, address, runner, log):
-    as_completed = dask_distributed().as_completed
-
-    with client:
-        workers = client.scheduler_info().get("workers", {})
-        if not workers:
-            log(f"no Dask worker at {address} yet; the runs wait for one (`dask worker {address} --nthreads 1`)")
-        threads = sorted({w.get("nthreads", 1) for w in workers.values()})
-        if threads and threads[-1] > 1:
-            log(f"note: Dask workers with {threads[-1]} threads run one insertion at a time; start them with "
-                "--nthreads 1 and one worker per core for full use of the machine")
-        token = uuid.uuid4().hex[:8]
-        futures = {client.submit(execute, case, runner, key=f"insertion-{case.key()}-{token}"): case for case in cases}
-        try:
-            for future in as_completed(futures, loop=client.loop):
-                case = futures[future]
-                try:
-                    outcome = future.result()
-                except Exception as exc:  # the task itself failed: worker lost (KilledWorker), cancelled, ...
-                    outcome = _failed(case, f"{type(exc).__name__}: {' '.join(str(exc).split())}")
-                future.release()
-                yield case, outcome
-        finally:
-            client.cancel(list(futures))
-
-
 @dataclass
 class SweepReport:
     """What a call to :func:`run_sweep` did."""
@@ -436,5 +289,5 @@ def describe_cases(cases) -> str:
     return frame[["key", *varying]].to_string(index=False)
 
 
-__all__ = ["LocalPool", "SweepStore", "SweepReport", "run_sweep", "local_outcomes", "dask_outcomes", "read_results",
+__all__ = ["SweepStore", "SweepReport", "run_sweep", "read_results",
            "result_row", "input_row", "describe_cases", "IDENTITY", "OUTPUTS", "TABLE"]
