@@ -7,9 +7,9 @@ sqrt(1e6) = 1000, and a run of seconds becomes one of hours that looks like a ha
 the solver's stable time step at the start and the push duration, and estimates the steps and
 the wall time; :func:`check_run_budget` refuses a run over a step limit, naming the likely cause.
 
-The estimate is of the start: contact later shortens the step a little (a default RSJ run: 12,600
-steps estimated, 14,800 taken), a run may end before the push does (the tip passed the end), and
-the closing hold is counted at its shortest (``settle_s``; a run that takes long to come to rest
+The estimate is of the start: contact later shortens the step a little (RSJ, D 36 mm, 13.3 mm
+scope: 35,961 steps estimated, 41,326 taken), a run may end before the push does (the tip passed
+the end), and the closing hold is counted at its shortest (``settle_s``; a run that takes long to come to rest
 holds up to ``settle_max_s``).
 """
 
@@ -20,11 +20,14 @@ from dataclasses import dataclass
 
 from colonsim.errors import ColonsimError
 
-DEFAULT_MAX_STEPS = 2_000_000  # ~100 x a default run (12,000-32,000 steps); ~30 min on one core
-# Wall time of one solver step on one core, a + b * nodes, measured on the 2-core development
-# machine with one Numba thread: RSJ default mesh 0.96 ms/step at 3141 nodes, 7.5 mm mesh
-# 0.31 ms/step at 557 nodes. Machines differ: this sizes a run, it does not time it.
-STEP_COST_S = (1.5e-4, 2.6e-7)
+DEFAULT_MAX_STEPS = 2_000_000  # 20-70 x a default run (28,000-99,000 steps, thesis sweep); ~15 min on one core
+# Wall time of one solver step on one core, a + b * (nodes not held at the start: the scope's and
+# the free wall's; a held wall costs next to nothing, docs/model.md "Cost"), fitted to the 39 runs
+# of the thesis sweep (2026-11-25, 2 workers on an idle 2-core machine, one Numba thread each):
+# within 22 % for every run, 0.20 ms/step at 101 such nodes (fixed THF) to 0.62 at 4141 (THF);
+# the count of all nodes was off by up to 135 %. Machines differ (the same runs have taken up to
+# 3 times longer on other days): this sizes a run, it does not time it.
+STEP_COST_S = (1.52e-4, 1.13e-7)
 STIFF_RATIO = 100.0  # a wall this many times stiffer than the reference tissue is named as the cause
 
 
@@ -45,7 +48,7 @@ class RunBudget:
     limited_by: str  # the body with the smallest stable step (colon wall or scope)
     simulated_s: float  # duration of the push
     steps: float
-    nodes: int
+    nodes: int  # the scope's and the wall's nodes not held at the start (what a step costs)
     wall_time_s: float
     wall_mu0_Pa: float
     reference_mu0_Pa: float
@@ -94,7 +97,7 @@ def estimate_run(case) -> RunBudget:
     if model.push.settle_start is not None:  # the closing hold at its shortest: most runs come to rest early
         duration -= case.settle_max_s - case.settle_s
     steps = duration / dt
-    nodes = sum(len(solver.state[b.name].x) for b in solver.bodies)
+    nodes = sum(len(solver.state[b.name].x) for b in solver.bodies) - len(model.fixed_nodes)
     a, b = STEP_COST_S
     return RunBudget(case=case, time_step_s=dt, limited_by=min(stable, key=stable.get), simulated_s=duration,
                      steps=steps, nodes=nodes, wall_time_s=steps * (a + b * nodes),
