@@ -10,8 +10,9 @@ from matplotlib.lines import Line2D
 from colonsim.files import save_figure
 from colonsim.insertion.study.reference import SOURCE_RSJ_CM
 from colonsim.insertion.case.results import read_final_shape
+from colonsim.insertion.case.scenario import insertion_geometry
 
-from validation_sections import RSJ_DIAMETERS, case_geometry
+from validation_sections import RSJ_DIAMETERS
 from validation_sweeps import SCOPES, role
 
 COLOURS = {"utc": "tab:blue", "pdc": "tab:orange", "sdc": "tab:red", None: "tab:gray"}
@@ -94,7 +95,7 @@ def final_shapes(panels, path, title):
     for ax, (name, runs) in zip(axes, panels):
         rest_drawn = False
         for case, folder in runs:
-            g = case_geometry(case)
+            g = insertion_geometry(case)  # the run's own colon, its exit lengthened as the run had it
             ring_size = int(g.end_ring.sum()) // 2  # the first and the last ring
             mobile = g.mobile.reshape(-1, ring_size).all(axis=1)
             left, right, axis = wall_outline(g.nodes, ring_size)

@@ -59,7 +59,8 @@ from colonsim.insertion.engine.shell import Shell
 from colonsim.insertion.engine.solver import ExplicitSolver
 from colonsim.insertion.engine.tip_resistance import TipResistance
 
-__all__ = ["COLON_DENSITY", "Insertion", "InsertionCase", "InsertionResult", "build_insertion", "run_insertion"]
+__all__ = ["COLON_DENSITY", "Insertion", "InsertionCase", "InsertionResult", "build_insertion", "insertion_geometry",
+           "run_insertion"]
 
 COLON_DENSITY = 1040.0  # kg/m^3
 DISTAL_RAMP = 0.01  # m of exit over which the distal resistance engages (assumption, docs/model.md "Loading")
@@ -89,9 +90,9 @@ class Insertion:
     resistance: TipResistance | None = None
 
 
-def build_insertion(case: InsertionCase) -> Insertion:
-    """Bodies, contact, constraints and manoeuvre of ``case`` (SI inside)."""
-    case.validate()
+def insertion_geometry(case: InsertionCase):
+    """The colon ``case`` runs in (SI): its model's geometry, with the exit lengthened to take the
+    scope's available length where the model says so (RSF, THF, fixed THF, fixed-ending patients)."""
     D = case.diameter_mm * 1e-3
     anatomy = colon_model(case.segment)
 
@@ -114,6 +115,14 @@ def build_insertion(case: InsertionCase) -> Insertion:
                 geometry = geometry_with_exit(needed)
             except TubeClash:  # run straight on, the exit would cross the colon: it folds out of the plane
                 geometry = geometry_with_exit(needed, fold_after=exit_length)
+    return geometry
+
+
+def build_insertion(case: InsertionCase) -> Insertion:
+    """Bodies, contact, constraints and manoeuvre of ``case`` (SI inside)."""
+    case.validate()
+    anatomy = colon_model(case.segment)
+    geometry = insertion_geometry(case)
     material = case_material(case.material, case.material_parameters)
     shell = Shell(geometry.nodes, geometry.triangles, case.wall_thickness_mm * 1e-3, material,
                   density=COLON_DENSITY, name="colon")
