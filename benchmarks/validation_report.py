@@ -95,15 +95,16 @@ def flexure_models(main, out):
 
 
 def resistance_section(sweep, out):
-    """The distal resistance section, with the final shapes at 10 N per RSF/THF angle."""
+    """The distal resistance section, with the final shapes at one level per RSF/THF angle."""
     section = resistance.resistance_section(sweep)
     if section["ran"]:
         speed = InsertionCase().push_speed
         for segment in ("rsf", "thf"):
-            entries = [(c, sweep) for c in sweep.cases if c.segment == segment and c.distal_resistance_N == 10.0
+            level = resistance.SHAPES_LEVEL_N
+            entries = [(c, sweep) for c in sweep.cases if c.segment == segment and c.distal_resistance_N == level
                        and math.isclose(c.push_speed, speed)]
-            fig = shape_figure(entries, f"figures/{segment}_shapes_10N.png",
-                               f"{segment.upper()}, 10 N distal resistance: final shapes per angle", out)
+            fig = shape_figure(entries, f"figures/{segment}_shapes_{level:g}N.png",
+                               f"{segment.upper()}, {level:g} N distal resistance: final shapes per angle", out)
             section["figures"] += [fig] if fig else []
     return section
 

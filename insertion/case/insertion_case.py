@@ -146,8 +146,10 @@ class InsertionCase:
                      "friction", "distal_resistance_N"):  # the ranges every command shares
             check_input_range(name, getattr(self, name))
         checks = [
-            ("scope_spacing_mm", self.scope_spacing_mm, 1.0, 50.0, f"scope node spacing in mm ({InsertionCase.scope_spacing_mm:g} by default)"),
-            ("push_speed", self.push_speed, 1e-3, 5.0, f"push speed in m/s ({InsertionCase.push_speed:g}; 0.6 in the source)"),
+            ("scope_spacing_mm", self.scope_spacing_mm, 1.0, 50.0,
+             f"scope node spacing in mm ({InsertionCase.scope_spacing_mm:g} by default)"),
+            ("push_speed", self.push_speed, 1e-3, 5.0,
+             f"push speed in m/s ({InsertionCase.push_speed:g}; 0.6 in the source)"),
             ("colon_damping", self.colon_damping, 0.0, 1e4, "damping in 1/s"),
             ("scope_damping", self.scope_damping, 0.0, 1e4, "damping in 1/s"),
             ("scope_lateral_damping", self.scope_lateral_damping, 0.0, 1e4, "damping in 1/s"),

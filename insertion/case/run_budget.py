@@ -9,8 +9,8 @@ the wall time; :func:`check_run_budget` refuses a run over a step limit, naming 
 
 The estimate is of the start: contact later shortens the step a little (RSJ, D 36 mm, 13.3 mm
 scope: 35,961 steps estimated, 41,326 taken), a run may end before the push does (the tip passed
-the end), and the closing hold is counted at its shortest (``settle_s``; a run that takes long to come to rest
-holds up to ``settle_max_s``).
+the end), and the closing hold is counted at its shortest (``settle_s``; a run that takes long to
+come to rest holds up to ``settle_max_s``).
 """
 
 from __future__ import annotations

@@ -30,7 +30,7 @@ class LocalPool:
 
     Workers are spawned (not forked: the parent may hold Numba threads) with one Numba thread
     each, when first needed; a pool broken by a dying worker is replaced by a fresh one. Use it
-    as a context manager, or call :meth:`close`.
+    as a context manager: leaving the block shuts the processes down.
     """
 
     def __init__(self, workers, warm_up=True):
@@ -49,9 +49,6 @@ class LocalPool:
         if self._executor is not None:
             self._executor.shutdown(wait=wait, cancel_futures=True)
             self._executor = None
-
-    def close(self):
-        self.discard(wait=True)
 
     def __enter__(self):
         return self
