@@ -291,11 +291,13 @@ def smoothness(section):
     lines += ["**A surrogate's held-out error** (`gp_train.toml`, 20 runs, fits the project's surrogate; "
               "`gp_test.toml`, 30 independent runs in the same ranges, scores it): RSJ, scope 9-13.5 mm, D 20-40 mm, "
               "mu 0-0.1. RMSE of the predictions as a share of the held-out output's standard deviation; pass under "
-              "5 %. Coverage: the share of held-out runs inside the predicted 95 % interval. What limits the error: "
+              "5 %. Coverage: the share of held-out runs inside the predicted 95 % interval ('-': the model says "
+              "its error is unknown and gives no interval, docs/surrogate.md 'Too few runs'). What limits the error: "
               "a surrogate fitted on both sweeps (50 runs) gives its leave-one-out RMSE and the noise sd it "
               "estimates, the runs' own scatter about a smooth trend (both as a share of the output's sd over both "
-              "sweeps). Held-out runs carry that scatter: where it is above 5 %, more training runs cannot pass "
-              "the check; where it is well below and the error on both sweeps is too, 20 runs were too few.", ""]
+              "sweeps; of the largest deformation, modelled as the larger of points A and C (docs/surrogate.md), the "
+              "larger of theirs). Held-out runs carry that scatter: where it is above 5 %, more training runs cannot "
+              "pass the check; where it is well below and the error on both sweeps is too, 20 runs were too few.", ""]
     gp = section["surrogate"]
     if not gp["ran"]:
         lines += [f"{NOT_RUN}: no --gp-train-sweep and --gp-test-sweep.", ""]

@@ -428,6 +428,12 @@ def columns(kind=None, surrogate=None) -> tuple:
 # the sigmoid has relaxed in the fixed exit (docs/surrogate.md, "The pain proxy").
 PAIN_PROXY = "max_deformation_cm"
 
+# Outputs that are, run by run, the larger of two others: in the RSJ the largest deformation is the
+# larger of point A (the first maximum) and point C (the largest value after the minimum B) where a
+# run has both. The surrogate models such an output through its two smooth parts where both are
+# fitted and the identity holds on every training run (colonsim.surrogate.larger).
+LARGER_OF = {"max_deformation_cm": ("point_A_cm", "point_C_cm")}
+
 
 def column_unit(name) -> str:
     """Unit of a results-table column ("" for none, and for columns the catalog does not hold)."""

@@ -65,7 +65,8 @@ PATIENTS = (
     {"label": "young African patient", "age": "young", "region": "african"},
     {"label": "older European patient (diverticular disease)", "age": "older", "region": "european"},
 )
-SURROGATE_TARGETS = ("max_deformation_cm", "final_deformation_cm", "point_A_cm", "peak_contact_force_N",
+# points A and C: the largest deformation is modelled as the larger of the two (colonsim.surrogate.larger)
+SURROGATE_TARGETS = ("max_deformation_cm", "final_deformation_cm", "point_A_cm", "point_C_cm", "peak_contact_force_N",
                      "max_wall_stretch")
 
 

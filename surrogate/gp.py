@@ -168,6 +168,15 @@ class GaussianProcess:
         var = self.constant_ - np.einsum("ij,ij->j", v, v) + self.noise_level_
         return mean, self.y_scale_ * np.sqrt(np.maximum(var, 0.0))
 
+    def training_runs(self):
+        """The training runs' inputs (physical units) and outputs (target units)."""
+        return self.x_low_ + self.x_span_ * self.X_train_, self.y_mean_ + self.y_scale_ * self.y_train_
+
+    @property
+    def n_train(self) -> int:
+        """Number of training runs."""
+        return int(len(self.alpha_))
+
     @property
     def noise_std(self):
         """Standard deviation of the run-to-run scatter, target units."""

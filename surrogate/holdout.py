@@ -106,16 +106,17 @@ def score(model, table: pd.DataFrame, target, segment=None, name="held-out table
         segment = next(iter(model.domains_))
     domain, gp = model.model_for(segment, target)
     X, y, scope, left_out, outside = heldout_runs(model, table, segment, target, name)
-    mean, trend_cov = gp.predict(X, return_cov=True)
-    cov = trend_cov + np.eye(len(y)) * gp.noise_std**2  # new simulation results: trend + scatter
-    sd = np.sqrt(np.maximum(np.diag(cov), 0.0))
+    _, trend_cov = gp.predict(X, return_cov=True)
+    mean, sd = gp.predict(X, return_std=True)  # new simulation results: trend + scatter
+    cov = trend_cov.copy()  # the trends' covariance between runs, each run's own sd on the diagonal
+    cov[np.diag_indices_from(cov)] = sd**2
     err = y - mean
     z = err / sd
     ss = float(np.sum((y - y.mean()) ** 2))
     stated, held = pair_orders(mean, cov, scope)
     holds = held(y)
     return {"segment": domain.segment, "target": target, "n": int(len(y)), "left_out": left_out,
-            "outside_box": outside, "n_train": int(len(gp.alpha_)),
+            "outside_box": outside, "n_train": gp.n_train,
             "rmse": float(np.sqrt(np.mean(err**2))), "q2": float(1.0 - np.sum(err**2) / ss) if ss > 0 else None,
             "coverage": {f"{round(100 * p)}": coverage(err, sd, p) for p in NOMINAL},
             "z_mean": float(z.mean()), "z_sd": float(z.std(ddof=1)),
@@ -145,7 +146,8 @@ def format_score(s, unit="") -> str:
 
 def reliability_figure(scores, title="held-out runs"):
     """Nominal against observed coverage of the central intervals, one line per score (a model
-    and output); the diagonal is a calibrated model, below it the intervals are too narrow."""
+    and output; its optional "label" and "style", keywords of the line); the diagonal is a
+    calibrated model, below it the intervals are too narrow."""
     from matplotlib.figure import Figure
 
     fig = Figure(figsize=(4.8, 4.6))
@@ -153,7 +155,7 @@ def reliability_figure(scores, title="held-out runs"):
     ax.plot([0, 1], [0, 1], color="0.6", lw=1, ls="--", label="calibrated")
     for s in scores:
         r = s["reliability"]
-        ax.plot(r["nominal"], r["observed"], "o-", ms=3,
+        ax.plot(r["nominal"], r["observed"], "o-", ms=3, **s.get("style", {}),
                 label=s.get("label") or f"{s['segment']} {s['target']} ({s['n_train']} runs)")
     ax.set_xlim(0, 1)
     ax.set_ylim(0, 1)

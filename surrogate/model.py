@@ -3,8 +3,9 @@
 ``SweepSurrogate(...).fit(table)`` returns the fitted estimator; ``predict(query, segment, target,
 return_std=True)`` answers in microseconds. Learned state lives in attributes ending with ``_``:
 ``domains_`` (segment -> :class:`SegmentDomain`), ``models_`` (segment -> target ->
-:class:`GaussianProcess`), ``cv_`` (segment -> target -> cross-validation metrics), ``skipped_``
-(segment -> target -> why no model), ``scatter_`` (segment -> target -> the scatter measured by
+:class:`GaussianProcess`, or :class:`LargerOf` for an output that is the larger of two fitted
+ones, :mod:`colonsim.surrogate.larger`), ``cv_`` (segment -> target -> cross-validation
+metrics), ``skipped_`` (segment -> target -> why no model), ``scatter_`` (segment -> target -> the scatter measured by
 replicate runs, or None), ``notes_`` (things about the table a user should know).
 """
 
@@ -17,12 +18,14 @@ from colonsim.errors import ColonsimError
 from colonsim.surrogate.domain import SegmentDomain
 from colonsim.surrogate.replicates import replicate_scatter
 from colonsim.surrogate.gp import GaussianProcess
+from colonsim.surrogate.larger import LargerOf, cross_validate_larger, identity_holds
 from colonsim.surrogate.table import (INPUT_OPTIONS, INPUTS, PAIN_PROXY, TARGETS, check_results, numeric_column,
                                       scope_diameter_mm, scope_diameters, solver_settings, split_inputs,
                                       successful_runs)
 from colonsim.surrogate.tissue import TISSUE_INPUTS, TissueDistribution, plan, split_predict, tissue_inputs
 from colonsim.surrogate.validation import Z95, cross_validate, error_unknown
 from colonsim.insertion.study.material_samples import MATERIAL_PARAMETERS
+from colonsim.catalog import LARGER_OF
 
 # columns of each target in predict_frame (the 95 % interval is mean +- 1.96 total sd)
 SUFFIXES = ("", "_std", "_low95", "_high95", "_std_tissue", "_std_surrogate")
@@ -129,6 +132,7 @@ class SweepSurrogate:
                                    "they train like the others")
             self.models_[segment], self.cv_[segment], self.skipped_[segment] = {}, {}, {}
             self.scatter_[segment] = {}
+            fitted = {}  # target -> (rows used, their values, GP factory): what a larger-of model needs
             for target in self.targets:
                 y = numeric_column(runs, target).to_numpy()
                 keep = np.isfinite(y)
@@ -155,6 +159,8 @@ class SweepSurrogate:
                                         f"to {y[keep].max():.3g}); check that column's values and unit")
                 self.models_[segment][target] = gp
                 self.cv_[segment][target] = cross_validate(gp, X, y[keep], self.cv, make_gp, self.random_state)
+                fitted[target] = (keep, y[keep], make_gp)
+            self._larger_of(segment, runs, varying, fitted)
         self.tissue_, note = ((self.tissue, None) if self.tissue is not None
                               else TissueDistribution.from_runs(table[table["status"] == "ok"]))
         if note and any(tissue_inputs(d) for d in self.domains_.values()):
@@ -163,6 +169,26 @@ class SweepSurrogate:
             reasons = "; ".join(f"{s} {t}: {why}" for s, d in self.skipped_.items() for t, why in d.items())
             raise ColonsimError(f"no model could be fitted ({reasons or 'no successful run in the segments asked for'})")
         return self
+
+    def _larger_of(self, segment, runs, varying, fitted):
+        """Model each output that is the larger of two fitted ones (:data:`LARGER_OF`) through them,
+        where the identity holds on every run (:mod:`colonsim.surrogate.larger`)."""
+        for target, parts in LARGER_OF.items():
+            if target not in fitted or not all(p in fitted for p in parts):
+                continue
+            why = identity_holds(runs, target)
+            if why is None and not all((fitted[p][0] == fitted[target][0]).all() for p in parts):
+                why = "its parts have values on other runs than it"
+            if why is not None:
+                self.notes_.append(f"{segment} {target}: fitted as one output, not as the larger of "
+                                   f"{' and '.join(parts)} ({why})")
+                continue
+            keep, y, _ = fitted[target]
+            model = LargerOf(parts, *(self.models_[segment][p] for p in parts))
+            self.models_[segment][target] = model
+            self.cv_[segment][target] = cross_validate_larger(
+                model, runs.loc[keep, varying].to_numpy(dtype=float), [fitted[p][1] for p in parts], y, self.cv,
+                [fitted[p][2] for p in parts], self.random_state)
 
     # -- queries -------------------------------------------------------------------------------------
     def model_for(self, segment, target):
@@ -287,12 +313,16 @@ class SweepSurrogate:
             lines.append(domain.describe())
             for target, gp in self.models_[seg].items():
                 cv = self.cv_[seg][target]
-                scales = ", ".join(f"{n} {v:.2g}" for n, v in zip(domain.inputs, gp.length_scale_))
+                if isinstance(gp, LargerOf):
+                    about = gp.description
+                else:
+                    scales = ", ".join(f"{n} {v:.2g}" for n, v in zip(domain.inputs, gp.length_scale_))
+                    about = f"scatter sd {gp.noise_std:.2g}  length scales ({scales})"
                 lines.append(f"  {target:<22} n {cv['n']:>3}  CV RMSE {cv['rmse']:.3g}  max {cv['max_abs_error']:.3g}  "
                              f"95% coverage {100 * cv['coverage_95']:.0f} %  Q2 {cv['q2'] if cv['q2'] is None else round(cv['q2'], 3)}  "
-                             f"scatter sd {gp.noise_std:.2g}  length scales ({scales})")
+                             f"{about}")
                 scatter = self.scatter_.get(seg, {}).get(target)
-                if scatter:
+                if scatter and not isinstance(gp, LargerOf):  # a larger-of model's parts have their own floors
                     lines.append(f"  {'':<22} noise floor {scatter['sd']:.2g} (scatter of {scatter['pairs']} replicate "
                                  f"pairs; their offset {scatter['offset']:+.2g})")
                 unknown = error_unknown(cv, gp)
@@ -305,8 +335,8 @@ class SweepSurrogate:
                          f"{self.tissue_.description}")
         lines.extend(f"note: {n}" for n in self.notes_)
         if self.domains_:
-            first = next(iter(self.cv_.values()), {})
-            scheme = next(iter(first.values()), {}).get("scheme")
+            scheme = next((self.cv_[s][t].get("scheme") for s in self.models_ for t, gp in self.models_[s].items()
+                           if isinstance(gp, GaussianProcess)), None)  # a larger-of model's: its parts'
             if scheme:
                 lines.append(f"cross-validation: {scheme}; length scales are in units of the training range "
                              "(>> 1: the output barely depends on that input)")

@@ -20,7 +20,6 @@ from __future__ import annotations
 
 import json
 from dataclasses import dataclass, field
-from pathlib import Path
 
 from colonsim.catalog import COLON_MODELS
 from colonsim.errors import ColonsimError

@@ -38,8 +38,7 @@ def prediction_figure(model, segment, vs, inputs: dict, target=PAIN_PROXY, scope
     curves = [None]
     if vs != "scope_diameter_mm" and "scope_diameter_mm" in domain.inputs:
         curves = [str(s).lower() for s in (scopes or default_scopes(domain))]
-    X_runs = gp.x_low_ + gp.x_span_ * gp.X_train_
-    y_runs = gp.y_mean_ + gp.y_scale_ * gp.y_train_
+    X_runs, y_runs = gp.training_runs()
     for scope in curves:
         query = dict(inputs)
         if scope is not None:

@@ -1,11 +1,12 @@
 """Save a fitted surrogate to open files and load it back without pickle.
 
 ``MODEL.json`` (readable): format and version, the estimator's settings, per segment the training
-domain, per output the kernel hyperparameters, scaling, cross-validation metrics, the tissue
-distribution predictions average over, and the name and SHA-256 of the arrays file. ``MODEL.npz`` (numpy arrays, read with ``allow_pickle=False``): per
-segment and output the scaled training inputs, the standardized training outputs, ``alpha`` =
-K^-1 y and the lower Cholesky factor L of K. That is everything prediction needs: loading neither
-refits nor imports scikit-learn.
+domain, per output the kernel hyperparameters, scaling, cross-validation metrics (an output that is
+the larger of two others: their names), the tissue distribution predictions average over, and the
+name and SHA-256 of the arrays file. ``MODEL.npz`` (numpy arrays, read with
+``allow_pickle=False``): per segment and output the scaled training inputs, the standardized
+training outputs, ``alpha`` = K^-1 y and the lower Cholesky factor L of K. That is everything
+prediction needs: loading neither refits nor imports scikit-learn.
 """
 
 from __future__ import annotations
@@ -26,13 +27,15 @@ from colonsim.inputs import check_input, read_input_text
 from colonsim.limits import TABLE_MAX_BYTES
 from colonsim.surrogate.domain import SegmentDomain
 from colonsim.surrogate.gp import GaussianProcess
+from colonsim.surrogate.larger import LargerOf
 from colonsim.surrogate.model import SweepSurrogate
 from colonsim.surrogate.store_checks import IDENTITY, arrays_path, check_domain, check_entry
 from colonsim.surrogate.tissue import TissueDistribution
 
 FORMAT = "colonsim-surrogate"
 # 1.2: the noise floor and scatter of replicate runs; the arrays say which segment and output they belong to
-FORMAT_VERSION = "1.2"
+# 1.3: an output that is the larger of two others is stored as their names ("larger_of"), without arrays
+FORMAT_VERSION = "1.3"
 ARRAYS = ("X_train", "y_train", "alpha", "L")
 
 
@@ -58,6 +61,10 @@ def save_surrogate(model: SweepSurrogate, path, source=None):
     for seg, domain in model.domains_.items():
         entries = {}
         for target, gp in model.models_[seg].items():
+            if isinstance(gp, LargerOf):  # no arrays: predicted from its parts' models
+                entries[target] = {"larger_of": list(gp.names), "n_train": gp.n_train,
+                                   "cross_validation": model.cv_[seg][target], "scatter": model.scatter_[seg].get(target)}
+                continue
             for name in ARRAYS:
                 arrays[_key(seg, target, name)] = getattr(gp, name + "_")
             arrays[_key(seg, target, IDENTITY)] = np.array([seg, target])
@@ -67,7 +74,7 @@ def save_surrogate(model: SweepSurrogate, path, source=None):
                 "length_scale": dict(zip(domain.inputs, gp.length_scale_.tolist())),
                 "x_low": gp.x_low_.tolist(), "x_span": gp.x_span_.tolist(),
                 "y_mean": gp.y_mean_, "y_scale": gp.y_scale_, "noise_std": gp.noise_std,
-                "log_marginal_likelihood": gp.log_marginal_likelihood_, "n_train": int(len(gp.alpha_)),
+                "log_marginal_likelihood": gp.log_marginal_likelihood_, "n_train": gp.n_train,
                 "cross_validation": model.cv_[seg][target],
                 "noise_floor_sd": gp.noise_floor_sd, "scatter": model.scatter_[seg].get(target),
             }
@@ -141,7 +148,10 @@ def _read_pair(doc, json_path, npz_path) -> SweepSurrogate:
                 model.domains_[seg] = domain
                 model.models_[seg], model.cv_[seg], model.skipped_[seg] = {}, {}, dict(entry["skipped"])
                 model.scatter_[seg] = {}
+                larger = {t: m for t, m in entry["models"].items() if "larger_of" in m}
                 for target, m in entry["models"].items():
+                    if target in larger:
+                        continue
                     check_entry(seg, target, m, domain, arrays, lambda name: _key(seg, target, name), json_path)
                     # files of format 1.0 and 1.1 hold no floor nor scatter
                     gp = GaussianProcess(input_range=(domain.low, domain.high),
@@ -156,6 +166,15 @@ def _read_pair(doc, json_path, npz_path) -> SweepSurrogate:
                     model.models_[seg][target] = gp
                     model.cv_[seg][target] = m["cross_validation"]
                     model.scatter_[seg][target] = m.get("scatter")
+                for target, m in larger.items():
+                    parts = [str(p) for p in m["larger_of"]]
+                    if len(parts) != 2 or not all(isinstance(model.models_[seg].get(p), GaussianProcess) for p in parts):
+                        raise ColonsimError(f"{json_path}: segment {seg}, {target} is the larger of {' and '.join(parts)}, "
+                                            "which the file does not hold; refit the surrogate")
+                    model.models_[seg][target] = LargerOf(parts, *(model.models_[seg][p] for p in parts))
+                    model.cv_[seg][target] = m["cross_validation"]
+                    model.scatter_[seg][target] = m.get("scatter")
+                model.models_[seg] = {t: model.models_[seg][t] for t in entry["models"]}  # the fit's order
     except ColonsimError:
         raise
     except (KeyError, TypeError, ValueError, AttributeError, OSError, EOFError, zipfile.BadZipFile) as exc:

@@ -28,7 +28,8 @@ def synthetic_outputs(segment, scope_diameter_mm, diameter_mm, angle_deg, fricti
     final = synthetic_deformation(scope_diameter_mm, diameter_mm, angle_deg, friction)
     rsj = segment == "rsj"
     nan = np.full_like(final, np.nan)
-    return {"final_deformation_cm": final, "max_deformation_cm": 1.05 * final,
+    # RSJ: the largest deformation is the larger of points A and C, as in real runs (colonsim.catalog.LARGER_OF)
+    return {"final_deformation_cm": final, "max_deformation_cm": final if rsj else 1.05 * final,
             "point_A_cm": 0.55 * final if rsj else nan, "point_B_cm": 0.45 * final if rsj else nan,
             "point_C_cm": final if rsj else nan,
             "peak_contact_force_N": 0.5 + 0.08 * np.asarray(scope_diameter_mm) ** 1.5 * (1 + 3 * np.asarray(friction)),
@@ -60,6 +61,9 @@ def synthetic_sweep(n_runs=40, segments=("rsj", "rsf"), noise_cm=0.03, design="r
             out = synthetic_outputs(segment, d, D, a, mu)
             noisy = {k: float(v) + (0.0 if np.isnan(v) else rng.normal(0.0, noise_cm) * (1.0 if k.endswith("_cm") else 0.2))
                      for k, v in out.items()}
+            if segment == "rsj":  # C and the largest value are one sample; A can overtake it
+                noisy["point_C_cm"] = noisy["max_deformation_cm"]
+                noisy["max_deformation_cm"] = max(noisy["point_A_cm"], noisy["point_C_cm"])
             failed = i < n_failed
             rows.append({"key": f"{segment}-{i:04d}", "status": "failed" if failed else "ok",
                          "error": "SYNTHETIC failure" if failed else "", "wall_time_s": 1.0,

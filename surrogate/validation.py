@@ -42,8 +42,8 @@ def metrics(y, mean, std):
 def error_unknown(cv: dict, gp) -> str | None:
     """Why the model cannot state its error, or None when it can (docs/surrogate.md, "Too few runs").
 
-    ``cv``: its cross-validation metrics; ``gp``: the fitted :class:`GaussianProcess`. The error is
-    unknown when
+    ``cv``: its cross-validation metrics; ``gp``: the fitted :class:`GaussianProcess` (or
+    :class:`colonsim.surrogate.larger.LargerOf`, whose parts are checked). The error is unknown when
 
     - fewer than :data:`MIN_CHECKED_RUNS` runs were predicted without themselves;
     - the noise sits at the bottom of its range and no replicate runs measured it: the fit
@@ -59,7 +59,8 @@ def error_unknown(cv: dict, gp) -> str | None:
         return "its error was not cross-checked (a model of an older colonsim); refit it"
     if n < MIN_CHECKED_RUNS:
         return f"too few runs to know its error ({n} < {MIN_CHECKED_RUNS})"
-    if gp.noise_floor_sd <= 0 and gp.noise_level_ <= NOISE_AT_BOUND * gp.noise_bounds[0]:
+    if any(p.noise_floor_sd <= 0 and p.noise_level_ <= NOISE_AT_BOUND * p.noise_bounds[0]
+           for p in getattr(gp, "parts", (gp,))):  # a LargerOf: either part
         return ("too few runs to know its error: the fit put the run-to-run scatter at the bottom of its range instead "
                 "of estimating it; measure it with replicate runs (fit --replicates)")
     limit = float(np.sqrt(chi2.ppf(0.95, n) / n))
