@@ -19,6 +19,7 @@ from colonsim.insertion.case.insertion_case import InsertionCase
 from colonsim.insertion.case.outcomes import RINGING_LIMIT
 from colonsim.insertion.study.claims import evaluate_claims
 from colonsim.markdown import md_table, num
+from validation_resistance_readings import claim_readings
 from validation_sweeps import role, scope_label
 
 LEVELS_N = (0.0, 5.0, 10.0, 20.0)
@@ -61,15 +62,18 @@ def resistance_section(sweep) -> dict:
                          "peak_contact_force_N", "peak_push_force_N", "point_A_cm", "point_B_cm", "point_C_cm",
                          "ringing_ratio")},
                      "ended_by": str(row.get("ended_by", ""))})
+    claims = claims_per_level(sweep, speed)
     return {"ran": True, "rows": rows, "missing": missing, "differences": _differences(rows),
             "rsj": [r for r in rows if r["segment"] == "rsj"], "rate": _rate_pairs(sweep, speed),
-            "quasi_static": _quasi_static(rows), "claims": claims_per_level(sweep, speed), "figures": []}
+            "quasi_static": _quasi_static(rows), "claims": claims,
+            "claims_largest": claims_per_level(sweep, speed, "max_deformation_cm"),
+            "readings": claim_readings(claims, rows), "figures": []}
 
 
-def claims_per_level(sweep, speed) -> list:
+def claims_per_level(sweep, speed, quantity="final_deformation_cm") -> list:
     """The source's claims on the runs of each level at the default push speed (the preset's RSJ
     runs are at mu = 0, so the RSJ claims compare the scopes there and the friction claim cannot be
-    evaluated). One row per claim: its verdict and reason at every level."""
+    evaluated), comparing ``quantity``. One row per claim: its verdict and reason at every level."""
     table = sweep.table
     at_speed = table[np.isclose(table["push_speed"].astype(float), speed)]
     rows = {}
@@ -77,7 +81,7 @@ def claims_per_level(sweep, speed) -> list:
         subset = at_speed[np.isclose(at_speed["distal_resistance_N"].astype(float), level)]
         if subset.empty:
             continue
-        for claim in evaluate_claims(subset, frictions=(0.0,)):
+        for claim in evaluate_claims(subset, frictions=(0.0,), quantity=quantity):
             row = rows.setdefault(claim.name, {"name": claim.name, "statement": claim.statement, "levels": {}})
             row["levels"][f"{level:g}"] = {"verdict": claim.verdict, "reason": claim.reason,
                                            "missing": len(claim.missing)}
@@ -137,6 +141,11 @@ def _rate_pairs(sweep, speed) -> list:
     return out
 
 
+def _claims_table(claims) -> str:
+    return md_table(claims, [("claim", "statement")] + [
+        (f"{level:g} N", (lambda r, k=f"{level:g}": _verdict_cell(r["levels"].get(k)))) for level in LEVELS_N])
+
+
 def _verdict_cell(entry):
     if entry is None:
         return "-"
@@ -179,10 +188,18 @@ def markdown(section) -> list:
                                   else ("yes" if r["point_C_cm"] > r["point_A_cm"] else "no"))]), ""]
     if section["claims"]:
         lines += ["The source's claims at every level (RSJ at mu = 0: the friction claim needs runs the preset "
-                  "does not have):", "",
-                  md_table(section["claims"], [("claim", "statement")] + [
-                      (f"{level:g} N", (lambda r, k=f"{level:g}": _verdict_cell(r["levels"].get(k))))
-                      for level in LEVELS_N]), ""]
+                  "does not have):", "", _claims_table(section["claims"]), "",
+                  "The same claims on the largest deformation during the run (the source's end values are also its "
+                  "largest, docs/surrogate.md \"The pain proxy\"; the RSJ ordering compares points A and C either way):",
+                  "", _claims_table(section["claims_largest"]), ""]
+    readings = section.get("readings") or {}
+    if readings:
+        statements = {c["name"]: c["statement"] for c in section["claims"]}
+        lines += ["Readings of the claims reproduced at no level, from the runs' numbers (lag: the length of scope "
+                  "buckled behind the held tip):", ""]
+        for name, sentences in readings.items():
+            lines += [f"- *{statements[name]}*"] + [f"  - {x}" for x in sentences]
+        lines += [""]
     for fig in section["figures"]:
         lines += [f"![{fig['title']}]({fig['file']})", ""]
     diffs = section["differences"]

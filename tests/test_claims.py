@@ -179,3 +179,14 @@ def test_a_sweep_at_mu_0_only_is_judged_at_mu_0_when_told_so():
     assert len(told[0].evidence) == 4  # 2 small-caliber scopes x 2 diameters
     worse = replace(at_zero, "utc", 36, 0.0, final_deformation_cm=5.0)
     assert evaluate_claims(worse, frictions=(0.0,))[0].verdict == NOT_REPRODUCED
+
+
+def test_claims_compare_the_quantity_they_are_given():
+    """The source's end values are also its largest: the claims can compare the largest
+    deformation during the run instead of the end value, and then read that column only."""
+    table = rsj_table().query("friction == 0.0").assign(max_deformation_cm=lambda t: t["final_deformation_cm"])
+    worse_end = replace(table, "utc", 36, 0.0, final_deformation_cm=5.0)
+    on_end = evaluate_claims(worse_end, frictions=(0.0,))
+    on_largest = evaluate_claims(worse_end, frictions=(0.0,), quantity="max_deformation_cm")
+    assert on_end[0].verdict == NOT_REPRODUCED and on_largest[0].verdict == REPRODUCED
+    assert "max_deformation_cm" in on_largest[0].criterion

@@ -284,12 +284,16 @@ def rsj_ordering(table, diameters=RSJ_DIAMETERS, friction=0.0) -> ClaimResult:
     return _verdict(result, runs, failures)
 
 
-def evaluate_claims(table, frictions=FRICTIONS) -> list[ClaimResult]:
+def evaluate_claims(table, frictions=FRICTIONS, quantity="final_deformation_cm") -> list[ClaimResult]:
     """Every claim of the source, in the order it states them; ``frictions``: the RSJ frictions
-    the first two claims compare the scopes at (a sweep at mu = 0 only: ``(0.0,)``)."""
-    return [sc_deform_less_rsj(table, frictions=frictions), reduction_larger_at_small_diameter(table, frictions=frictions),
-            sc_less_friction_sensitive(table), angle_dependence(table, "rsf"), angle_dependence(table, "thf"),
-            rsj_ordering(table)]
+    the first two claims compare the scopes at (a sweep at mu = 0 only: ``(0.0,)``); ``quantity``:
+    the deformation the claims about deformation compare (the source's end values, which in its
+    runs are also the largest; ``max_deformation_cm`` compares the largest during the run). The
+    RSJ ordering compares points A and C whatever ``quantity`` is."""
+    return [sc_deform_less_rsj(table, frictions=frictions, quantity=quantity),
+            reduction_larger_at_small_diameter(table, frictions=frictions, quantity=quantity),
+            sc_less_friction_sensitive(table, quantity=quantity), angle_dependence(table, "rsf", quantity=quantity),
+            angle_dependence(table, "thf", quantity=quantity), rsj_ordering(table)]
 
 
 def _list(values, unit=""):
