@@ -155,7 +155,7 @@ def reliability_figure(scores, title="held-out runs"):
     ax.plot([0, 1], [0, 1], color="0.6", lw=1, ls="--", label="calibrated")
     for s in scores:
         r = s["reliability"]
-        ax.plot(r["nominal"], r["observed"], "o-", ms=3, **s.get("style", {}),
+        ax.plot(r["nominal"], r["observed"], **{"marker": "o", "ms": 3, "ls": "-", **s.get("style", {})},
                 label=s.get("label") or f"{s['segment']} {s['target']} ({s['n_train']} runs)")
     ax.set_xlim(0, 1)
     ax.set_ylim(0, 1)
