@@ -133,7 +133,8 @@ class SweepSurrogate:
             self.models_[segment], self.cv_[segment], self.skipped_[segment] = {}, {}, {}
             self.scatter_[segment] = {}
             fitted = {}  # target -> (rows used, their values, GP factory): what a larger-of model needs
-            for target in self.targets:
+            # an output that may be the larger of two others comes after them (its parts fitted first)
+            for target in sorted(self.targets, key=lambda t: t in LARGER_OF):
                 y = numeric_column(runs, target).to_numpy()
                 keep = np.isfinite(y)
                 if not varying:
@@ -151,6 +152,8 @@ class SweepSurrogate:
                 scatter = None if replicates is None else replicate_scatter(runs, replicates, segment,
                                                                             [*varying, *fixed], target)
                 self.scatter_[segment][target] = scatter
+                if self._larger_of(segment, runs, varying, fitted, target, keep, y[keep]):
+                    continue
                 make_gp = self._make_gp(domain, 0.0 if scatter is None else scatter["sd"])
                 with np.errstate(over="ignore", invalid="ignore"):  # an overflow shows in the check below
                     gp = make_gp().fit(X, y[keep])
@@ -160,7 +163,8 @@ class SweepSurrogate:
                 self.models_[segment][target] = gp
                 self.cv_[segment][target] = cross_validate(gp, X, y[keep], self.cv, make_gp, self.random_state)
                 fitted[target] = (keep, y[keep], make_gp)
-            self._larger_of(segment, runs, varying, fitted)
+            for store in (self.models_, self.cv_, self.skipped_, self.scatter_):  # in the order of the targets
+                store[segment] = {t: store[segment][t] for t in self.targets if t in store[segment]}
         self.tissue_, note = ((self.tissue, None) if self.tissue is not None
                               else TissueDistribution.from_runs(table[table["status"] == "ok"]))
         if note and any(tissue_inputs(d) for d in self.domains_.values()):
@@ -170,25 +174,26 @@ class SweepSurrogate:
             raise ColonsimError(f"no model could be fitted ({reasons or 'no successful run in the segments asked for'})")
         return self
 
-    def _larger_of(self, segment, runs, varying, fitted):
-        """Model each output that is the larger of two fitted ones (:data:`LARGER_OF`) through them,
-        where the identity holds on every run (:mod:`colonsim.surrogate.larger`)."""
-        for target, parts in LARGER_OF.items():
-            if target not in fitted or not all(p in fitted for p in parts):
-                continue
-            why = identity_holds(runs, target)
-            if why is None and not all((fitted[p][0] == fitted[target][0]).all() for p in parts):
-                why = "its parts have values on other runs than it"
-            if why is not None:
-                self.notes_.append(f"{segment} {target}: fitted as one output, not as the larger of "
-                                   f"{' and '.join(parts)} ({why})")
-                continue
-            keep, y, _ = fitted[target]
-            model = LargerOf(parts, *(self.models_[segment][p] for p in parts))
-            self.models_[segment][target] = model
-            self.cv_[segment][target] = cross_validate_larger(
-                model, runs.loc[keep, varying].to_numpy(dtype=float), [fitted[p][1] for p in parts], y, self.cv,
-                [fitted[p][2] for p in parts], self.random_state)
+    def _larger_of(self, segment, runs, varying, fitted, target, keep, y) -> bool:
+        """Model ``target`` (its values ``y`` on the rows ``keep`` of ``runs``) through its parts if it
+        is the larger of two fitted outputs (:data:`LARGER_OF`) and the identity holds on every run
+        (:mod:`colonsim.surrogate.larger`); False when it is to be fitted as one output."""
+        parts = LARGER_OF.get(target)
+        if parts is None or not all(p in fitted for p in parts):
+            return False
+        why = identity_holds(runs, target)
+        if why is None and not all((fitted[p][0] == keep).all() for p in parts):
+            why = "its parts have values on other runs than it"
+        if why is not None:
+            self.notes_.append(f"{segment} {target}: fitted as one output, not as the larger of "
+                               f"{' and '.join(parts)} ({why})")
+            return False
+        model = LargerOf(parts, *(self.models_[segment][p] for p in parts))
+        self.models_[segment][target] = model
+        self.cv_[segment][target] = cross_validate_larger(
+            model, runs.loc[keep, varying].to_numpy(dtype=float), [fitted[p][1] for p in parts], y, self.cv,
+            [fitted[p][2] for p in parts], self.random_state)
+        return True
 
     # -- queries -------------------------------------------------------------------------------------
     def model_for(self, segment, target):
