@@ -89,7 +89,7 @@ def test_zero_resistance_builds_no_resistance_and_keeps_the_key_of_before():
     case = InsertionCase(segment="rsf", angle_deg=45.0, element_size_mm=COARSE_MM, distal_resistance_N=0.0)
     assert build_insertion(case).resistance is None
     inputs = case.to_dict()
-    del inputs["distal_resistance_N"], inputs["failure_stretch"]  # the fields the runs of before lacked
+    del inputs["distal_resistance_N"], inputs["failure_stretch"], inputs["held_push_share"]  # the runs of before lacked them
     for name in ("centerline", "centerline_smoothing_mm", "material_parameters"):
         del inputs[name]
     import hashlib
@@ -103,7 +103,8 @@ def test_zero_resistance_builds_no_resistance_and_keeps_the_key_of_before():
 def test_the_resistance_waits_at_the_exit_and_the_exit_takes_the_length(segment, angle):
     model = build_insertion(InsertionCase(segment=segment, angle_deg=angle, element_size_mm=COARSE_MM))
     g, r = model.geometry, model.resistance
-    assert r is not None and r.resistance == 5.0 and r.creep_speed == pytest.approx(0.01 * model.case.push_speed)
+    assert r is not None and r.resistance == 5.0
+    assert r.creep_speed == pytest.approx(0.01 * model.case.held_push_share * model.case.push_speed)  # the held push's
     assert r.engagement == 0.0  # the tip starts at the entry, far before the exit
     assert resistance_share(g, g.exit_start - 1e-3) == 0.0 and resistance_share(g, g.exit_start + 1e-2) == 1.0
     assert resistance_share(g, g.exit_start + 5e-3) == pytest.approx(0.5)

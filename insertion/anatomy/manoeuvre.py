@@ -9,6 +9,9 @@ the scope is never jerked (a step in speed launches an axial wave of amplitude r
   constrained until the pushed depth reaches the end of the mobile part ("straighten", "stop"),
   let the system relax at rest with the constraint released ("birth and death"), then push on
   through the flexure.
+- Behind a held tip ("held push"): once the colon beyond the model holds the tip back, the push
+  goes on at a share of its speed (:meth:`PushProfile.slow`) to the same depth: the scope bowing
+  into a loop behind a held tip is the slowest part of an insertion.
 - Every run ends at rest ("settle"): the push slows to a stop over a given push distance and the
   scope is held still for a settling time, so the final state is an equilibrium at the final
   depth, not a snapshot of the motion. A run that ends before its planned depth because the tip
@@ -52,34 +55,46 @@ def _transition(tau, ramp):
 class PushProfile:
     """Push speed against time built from phases; speed changes take ``ramp`` seconds.
 
-    Each phase's speed is reached ``ramp`` after its start (a change starts at the phase start),
-    or its own ``Phase.ramp``.
+    Each phase starts from the speed and depth the previous one ended at and changes its speed to
+    its own over ``ramp`` (or its own ``Phase.ramp``) from its start; a phase that ends before
+    its change is complete hands on the speed it has reached.
     """
 
     phases: list
     ramp: float
-    _levels: list = field(init=False, repr=False)
+    _starts: list = field(init=False, repr=False)
+    slowed_at: float | None = field(default=None, init=False)  # s: when :meth:`slow` took effect
 
     def __post_init__(self):
         if self.ramp < 0:
             raise ColonsimError(f"ramp = {self.ramp} s must be >= 0")
-        self._levels = []
-        previous = 0.0
+        self._starts = []  # per phase: start time, speed and depth at the start, plateau speed, ramp
+        v = d = 0.0
         for p in self.phases:
-            self._levels.append((p.start, p.speed - previous, self.ramp_of(p)))
-            previous = p.speed
+            ramp = self.ramp_of(p)
+            self._starts.append((p.start, v, d, p.speed, ramp))
+            s, integral = _transition(p.end - p.start, ramp)
+            v, d = v + (p.speed - v) * s, d + v * (p.end - p.start) + (p.speed - v) * integral
 
     @property
     def duration(self):
         return self.phases[-1].end
 
+    def _at(self, t):
+        k = 0
+        while k + 1 < len(self._starts) and self._starts[k + 1][0] <= t:
+            k += 1
+        return self._starts[k]
+
     def speed(self, t):
         """Push speed at time ``t``, m/s."""
-        return sum(dv * _transition(t - t0, ramp)[0] for t0, dv, ramp in self._levels)
+        t0, v0, _, speed, ramp = self._at(t)
+        return v0 + (speed - v0) * _transition(t - t0, ramp)[0]
 
     def depth(self, t):
         """Insertion depth (distance pushed) at time ``t``, m."""
-        return sum(dv * _transition(t - t0, ramp)[1] for t0, dv, ramp in self._levels)
+        t0, v0, d0, speed, ramp = self._at(t)
+        return d0 + v0 * max(t - t0, 0.0) + (speed - v0) * _transition(t - t0, ramp)[1]
 
     @property
     def settle_start(self):
@@ -109,6 +124,42 @@ class PushProfile:
         self.phases = kept + [Phase(SETTLE, t, t + ramp + hold, 0.0, ramp=ramp)]
         self.__post_init__()
 
+    def slow(self, t, share) -> bool:
+        """From time ``t``, push at ``share`` of the current plateau speed to the same final depth
+        (the ``held push`` phase, its speed reached over the profile's ramp; a push that ends
+        sooner ends still slowing). A closing ``settle`` phase keeps its stop distance and hold.
+        Only once and only during the last push; returns whether the profile changed."""
+        moving = [p for p in self.phases if p.name != SETTLE]
+        last = moving[-1]
+        if (self.slowed_at is not None or not 0.0 < share < 1.0 or not last.start <= t < last.end
+                or last.speed <= 0.0):
+            return False
+        settle = self.phases[-1] if self.phases[-1].name == SETTLE else None
+        stop_distance = 0.5 * settle.ramp * last.speed if settle is not None else 0.0
+        hold = settle.end - settle.start - settle.ramp if settle is not None else 0.0
+        goal = self.depth(self.duration) - stop_distance  # where the slowing to rest begins
+        before = self.phases[:-1] if settle is not None else list(self.phases)
+        before[-1] = Phase(last.name, last.start, t, last.speed, last.lateral_constraint, last.ramp)
+        trial = PushProfile(before + [Phase(HELD_PUSH, t, math.inf, share * last.speed)], self.ramp)
+        if goal <= trial.depth(t):
+            return False
+        lo, hi = t, t + (goal - trial.depth(t)) / (share * last.speed)  # the speed stays above share * speed
+        for _ in range(200):  # depth rises monotonically: bisection to the last bit
+            mid = 0.5 * (lo + hi)
+            if mid in (lo, hi):
+                break
+            lo, hi = (mid, hi) if trial.depth(mid) < goal else (lo, mid)
+        end = hi
+        phases = before + [Phase(HELD_PUSH, t, end, share * last.speed)]
+        if settle is not None:
+            v = trial.speed(end)
+            ramp = 2.0 * stop_distance / v
+            phases.append(Phase(SETTLE, end, end + ramp + hold, 0.0, ramp=ramp))
+        self.phases = phases
+        self.slowed_at = t
+        self.__post_init__()
+        return True
+
     @property
     def lateral_constraint_end(self):
         """End of the last phase that holds the mobile part laterally, s (None: no such phase)."""
@@ -123,6 +174,7 @@ class PushProfile:
 
 
 SETTLE = "settle"
+HELD_PUSH = "held push"
 
 
 def _settle(phases, speed, stop_distance, settle):

@@ -16,8 +16,10 @@ Modelling choices (stated so they can be cited):
   (:class:`colonsim.insertion.engine.tip_resistance.TipResistance`, ``distal_resistance_N``),
   engaged over the first :data:`DISTAL_RAMP` of the exit (:func:`resistance_share`, set after
   every chunk of push from the tip's position along the centerline), along the lumen's direction
-  at the tip, regularised at :data:`DISTAL_CREEP_SHARE` of the push speed; in the models whose exit takes
-  the whole available length, the exit is lengthened so the tip cannot reach its far end;
+  at the tip, regularised at :data:`DISTAL_CREEP_SHARE` of the held push's speed; in the models whose exit
+  takes the whole available length, the exit is lengthened so the tip cannot reach its far end;
+- once the tip is held, the rest of the push goes on at ``held_push_share`` of the push speed, to
+  the same depth (:meth:`PushProfile.slow`, the ``held push`` phase; docs/model.md, "Loading");
 - quasi-static runs use mass-proportional damping, by default 60 1/s on the colon (about
   critical for its lowest bending modes of ~10 Hz) and 5 1/s on the scope (its rigid push
   through the sheath would otherwise feel a drag of alpha m v);
@@ -64,7 +66,7 @@ __all__ = ["COLON_DENSITY", "Insertion", "InsertionCase", "InsertionResult", "bu
 
 COLON_DENSITY = 1040.0  # kg/m^3
 DISTAL_RAMP = 0.01  # m of exit over which the distal resistance engages (assumption, docs/model.md "Loading")
-DISTAL_CREEP_SHARE = 0.01  # the resistance's regularisation speed, as a share of the push speed
+DISTAL_CREEP_SHARE = 0.01  # the resistance's regularisation speed, as a share of the held push's speed
 EXIT_MARGIN = 0.05  # m of exit left beyond the available length (the tip may cut the bends' corners)
 
 
@@ -172,7 +174,8 @@ def build_insertion(case: InsertionCase) -> Insertion:
     resistance = None
     if case.distal_resistance_N > 0.0 and geometry.exit_start is not None:
         resistance = TipResistance(rod, rod.tip_node, lumen_direction(geometry, geometry.exit_start),
-                                   case.distal_resistance_N, creep_speed=DISTAL_CREEP_SHARE * case.push_speed,
+                                   case.distal_resistance_N,
+                                   creep_speed=DISTAL_CREEP_SHARE * case.held_push_share * case.push_speed,
                                    engagement=0.0)
     solver = ExplicitSolver([rod, shell], contacts=[contact, lip], constraints=constraints,
                             damping={rod.name: case.scope_damping, "colon": case.colon_damping},
@@ -291,6 +294,8 @@ def run_insertion(case: InsertionCase, progress=None, snapshot_interval=None) ->
             share = resistance_share(model.geometry, last["tip_arc_m"])
             held = share > 0.0
             model.resistance.engage(share, lumen_direction(model.geometry, last["tip_arc_m"]) if held else None)
+            if held and not settling and ended_by is None:
+                push.slow(model.solver.time, case.held_push_share)  # once, in the last push (docs/model.md, "Loading")
         if ended_by is not None:
             if at_rest and model.solver.time >= push.hold_start + case.settle_s - 1e-12 and came_to_rest(recorder.rows):
                 break
