@@ -243,10 +243,14 @@ def mesh_pair(section):
 
 def rate_check(section):
     base, half = section.get("speeds") or ("?", "?")
+    share = section.get("held_share")
+    held = ("" if share is None or share == 1.0 else
+            f" Once the distal resistance holds the tip, both push at {share:g} of these speeds (docs/model.md, "
+            "\"Loading\").")
     return _pair_section(8, f"Rate check: {base} against {half} m/s",
                          "Every scope of one case per colon model pushed at half the speed (docs/model.md, \"Time "
                          f"integration and damping\": a quasi-static run does not depend on the push speed). Each cell: "
-                         f"{base} / {half} m/s. Velocity-proportional damping resists the slow motion of the "
+                         f"{base} / {half} m/s.{held} Velocity-proportional damping resists the slow motion of the "
                          "insertion with a force that halves with the speed: if the drag is linear in the speed, "
                          "a pair's change is half of what the damping moves at the default speed. " + _PAIR_RULE,
                          section)

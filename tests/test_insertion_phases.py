@@ -1,5 +1,6 @@
 """The RSF manoeuvre run end to end on a coarse mesh: straighten (mobile part held to its axis),
-relax (released, scope at rest), push on through the flexure into the fixed exit.
+relax (released, scope at rest), push on through the flexure into the fixed exit, where the
+distal resistance holds the tip and the push goes on at half its speed.
 
 A 6 mm wall mesh keeps the run to seconds; the phases and the constraint do not depend on the mesh.
 """
@@ -19,7 +20,7 @@ def rsf_run():
 def test_phases_follow_the_mobile_part(rsf_run):
     ts, model = rsf_run.timeseries, rsf_run.model
     phases = list(dict.fromkeys(ts["phase"]))
-    assert phases == ["straighten", "stop", "relax", "push", "settle"]
+    assert phases == ["straighten", "stop", "relax", "push", "held push", "settle"]
     held = ts[ts["phase"].isin(["straighten", "stop"])]
     relax = ts[ts["phase"] == "relax"]
     # straightening pushes to the end of the mobile part (the sigmoid and its half-fillet) ...
@@ -30,7 +31,7 @@ def test_phases_follow_the_mobile_part(rsf_run):
     # the final push goes on through the flexure: the run ends at the model's far end or when the
     # scope's available length is in, never on a jam
     assert rsf_run.summary["ended_by"] in ("far_end", "length_used")
-    assert ts["tip_arc_m"].iloc[-1] > model.geometry.centerline_length - 0.12  # in the fixed exit
+    assert ts["tip_arc_m"].iloc[-1] > model.geometry.exit_start + 0.05  # 5 cm into the fixed exit
 
 
 def test_mobile_part_moves_only_along_its_axis_while_straightened(rsf_run):
@@ -50,3 +51,20 @@ def test_mobile_part_moves_only_along_its_axis_while_straightened(rsf_run):
     # moves sideways as the scope bows into it
     assert across_held < 1e-9
     assert across_free > 1e-4
+
+
+def test_the_push_slows_once_the_tip_is_held_and_ends_at_the_same_depth(rsf_run):
+    ts, model = rsf_run.timeseries, rsf_run.model
+    case, push = model.case, model.push
+    held = ts[ts["phase"] == "held push"]
+    first = held.iloc[0]
+    # it starts at the first chunk (1 mm of push) after the tip entered the exit ...
+    assert first["tip_arc_m"] > model.geometry.exit_start
+    before = ts[ts["time_s"] < push.slowed_at - 2e-3]
+    assert before["tip_arc_m"].iloc[-1] < model.geometry.exit_start + 2e-3
+    assert abs(before["distal_force_N"]).max() < case.distal_resistance_N
+    # ... and, past its ramp, pushes at the share of the push speed
+    steady = held[held["time_s"] > push.slowed_at + case.ramp_s + 0.01]
+    speed = np.diff(steady["depth_m"]) / np.diff(steady["time_s"])
+    assert len(speed) > 100 and np.allclose(speed, case.held_push_share * case.push_speed, rtol=1e-6)
+    assert ts["depth_m"].iloc[-1] == pytest.approx(model.total_depth, abs=1e-9)  # to the depth of before

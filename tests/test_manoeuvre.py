@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from colonsim.errors import ColonsimError
-from colonsim.insertion.anatomy.manoeuvre import continuous_push, straighten_relax_push
+from colonsim.insertion.anatomy.manoeuvre import HELD_PUSH, SETTLE, continuous_push, straighten_relax_push
 
 
 def test_continuous_push_reaches_the_depth_smoothly():
@@ -44,3 +44,58 @@ def test_bad_profiles(args, message):
         continuous_push(*args)
     with pytest.raises(ColonsimError, match="must lie between 0 and the total depth"):
         straighten_relax_push(0.5, 0.4)
+
+
+def _integrated_depth(p, t_end):
+    t = np.linspace(0.0, t_end, 40001)
+    v = np.array([p.speed(x) for x in t])
+    return np.sum(0.5 * (v[1:] + v[:-1]) * np.diff(t))
+
+
+@pytest.mark.parametrize("stop_mm", [0.0, 5.0])
+def test_the_held_push_goes_on_at_its_share_to_the_same_depth(stop_mm):
+    p = straighten_relax_push(0.20, 0.68, speed=0.3, ramp=0.4, relax=0.1, stop_distance=stop_mm * 1e-3, settle=1.0)
+    planned, hold = p.duration, p.phases[-1].end - p.phases[-1].start - p.phases[-1].ramp
+    t = p.phases[3].start + 0.8  # in the last push, at its plateau
+    assert p.slow(t, 0.5)
+    names = [ph.name for ph in p.phases]
+    assert names == ["straighten", "stop", "relax", "push", HELD_PUSH, SETTLE]
+    held, settle = p.phases[-2], p.phases[-1]
+    assert held.start == t and held.speed == pytest.approx(0.15)
+    assert p.speed(t) == pytest.approx(0.3) and p.speed(t + 0.4 + 1e-9) == pytest.approx(0.15, rel=1e-9)
+    # the closed form: the remaining push at 0.15 m/s after a (1 - cos) ramp from 0.3 (covering 0.09 m)
+    remaining = 0.68 - p.depth(t)
+    assert settle.start - t == pytest.approx(0.4 + (remaining - stop_mm * 1e-3 - 0.09) / 0.15, rel=1e-9)
+    assert p.depth(p.duration) == pytest.approx(0.68, rel=1e-12)
+    # depth is the speed's integral (the trapezoids miss up to v dt / 2 = 7.5e-6 m at the stop to rest)
+    assert _integrated_depth(p, p.duration) == pytest.approx(0.68, abs=1e-5)
+    assert settle.end - settle.start - settle.ramp == pytest.approx(hold)  # the hold at rest is kept
+    assert p.speed(settle.end - 1e-9) == 0.0 and p.duration > planned
+    assert p.slowed_at == t and not p.slow(t + 0.1, 0.5)  # once only
+
+
+def test_a_push_that_ends_while_slowing_ends_at_its_depth_and_rests():
+    p = continuous_push(0.28, speed=0.3, ramp=0.4, settle=1.0)
+    t = p.phases[0].end - 0.1  # 3 cm before the end: shorter than the 9 cm the slowing takes
+    assert p.slow(t, 0.5)
+    end = p.settle_start
+    assert 0.15 < p.speed(end - 1e-9) < 0.3  # still slowing when the depth is reached
+    assert p.depth(end) == pytest.approx(0.28, rel=1e-12) and p.speed(end + 1e-9) == 0.0
+
+
+def test_a_stop_during_a_speed_change_stops_from_the_speed_reached():
+    p = continuous_push(0.28, speed=0.3, ramp=0.4, settle=1.0)
+    p.slow(0.5, 0.5)
+    v = p.speed(0.6)
+    assert 0.15 < v < 0.3
+    p.stop(0.6, 0.005, 0.5)
+    assert p.depth(p.hold_start) == pytest.approx(p.depth(0.6) + 0.005, rel=1e-12)  # slows to rest over 5 mm
+    assert p.speed(p.hold_start + 1e-9) == 0.0
+
+
+@pytest.mark.parametrize("when, share", [("before", 0.5), ("push", 1.0), ("push", 0.0), ("settle", 0.5)])
+def test_no_slow_down_outside_the_last_push_or_without_a_share(when, share):
+    p = straighten_relax_push(0.20, 0.68, speed=0.3, ramp=0.4, relax=0.1, settle=1.0)
+    t = {"before": p.phases[0].start + 0.5, "push": p.phases[3].start + 0.8, "settle": p.phases[-1].start + 0.1}[when]
+    phases = list(p.phases)
+    assert not p.slow(t, share) and p.phases == phases and p.slowed_at is None

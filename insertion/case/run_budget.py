@@ -10,7 +10,9 @@ the wall time; :func:`check_run_budget` refuses a run over a step limit, naming 
 The estimate is of the start: contact later shortens the step a little (RSJ, D 36 mm, 13.3 mm
 scope: 35,961 steps estimated, 41,326 taken), a run may end before the push does (the tip passed
 the end), and the closing hold is counted at its shortest (``settle_s``; a run that takes long to
-come to rest holds up to ``settle_max_s``).
+come to rest holds up to ``settle_max_s``). The push behind a held tip (``held_push_share``) is
+counted from the pushed depth at which the tip would reach the exit along the centerline, without
+its speed ramp.
 """
 
 from __future__ import annotations
@@ -96,6 +98,9 @@ def estimate_run(case) -> RunBudget:
     duration = float(model.push.duration)
     if model.push.settle_start is not None:  # the closing hold at its shortest: most runs come to rest early
         duration -= case.settle_max_s - case.settle_s
+    if model.resistance is not None:  # the push behind a held tip, from the exit on, is slower
+        held = max(model.total_depth - model.geometry.exit_start, 0.0)
+        duration += held / case.push_speed * (1.0 / case.held_push_share - 1.0)
     steps = duration / dt
     nodes = sum(len(solver.state[b.name].x) for b in solver.bodies) - len(model.fixed_nodes)
     a, b = STEP_COST_S
