@@ -30,8 +30,8 @@ Modelling choices (stated so they can be cited):
   far end of the fixed exit, beyond which the tip would leave the model), when the available
   length is pushed in (``"length_used"``), when the wall's largest stretch passes
   ``failure_stretch`` (``"wall_stretch"``), or when the tip jams (``"jam"``,
-  :func:`colonsim.insertion.case.outcomes.jammed`; a tip held back by the distal resistance is
-  not a jam). A jam or a torn wall is an outcome: the summary says where and under which forces.
+  :func:`colonsim.insertion.case.outcomes.jammed`; once the distal resistance has engaged, the
+  tip is held back, not jammed, even where it slides back out of the exit's first millimetres). A jam or a torn wall is an outcome: the summary says where and under which forces.
 """
 
 from __future__ import annotations
@@ -271,6 +271,7 @@ def run_insertion(case: InsertionCase, progress=None, snapshot_interval=None) ->
     chunk_s = min(0.01, CHUNK_PUSH / case.push_speed)
     ended_by = None
     settling = at_rest = False
+    reached_exit = False  # the resistance has engaged: from then on the tip is held back, never jammed
     chunks = 0
     while model.solver.time < push.duration - 1e-9:
         if not settling and push.settle_start is not None and model.solver.time >= push.settle_start:
@@ -293,6 +294,7 @@ def run_insertion(case: InsertionCase, progress=None, snapshot_interval=None) ->
         if model.resistance is not None:  # engaged by where the tip is, along the lumen there (an exit may bend)
             share = resistance_share(model.geometry, last["tip_arc_m"])
             held = share > 0.0
+            reached_exit = reached_exit or held
             model.resistance.engage(share, lumen_direction(model.geometry, last["tip_arc_m"]) if held else None)
             if held and not settling and ended_by is None:
                 push.slow(model.solver.time, case.held_push_share)  # once, in the last push (docs/model.md, "Loading")
@@ -306,7 +308,7 @@ def run_insertion(case: InsertionCase, progress=None, snapshot_interval=None) ->
             ended_by = "length_used"
         elif model.solver.time >= last_push.start and tip_passed_end(last, model):
             ended_by = "tip_past_end" if model.geometry.end_depth < model.geometry.centerline_length else "far_end"
-        elif not held and recorder.jammed():
+        elif not reached_exit and recorder.jammed():
             ended_by = "jam"
         if ended_by is None:
             continue
