@@ -247,13 +247,22 @@ def rate_check(section):
     held = ("" if share is None or share == 1.0 else
             f" Once the distal resistance holds the tip, both push at {share:g} of these speeds (docs/model.md, "
             "\"Loading\").")
-    return _pair_section(8, f"Rate check: {base} against {half} m/s",
+    lines = _pair_section(8, f"Rate check: {base} against {half} m/s",
                          "Every scope of one case per colon model pushed at half the speed (docs/model.md, \"Time "
                          f"integration and damping\": a quasi-static run does not depend on the push speed). Each cell: "
                          f"{base} / {half} m/s.{held} Velocity-proportional damping resists the slow motion of the "
                          "insertion with a force that halves with the speed: if the drag is linear in the speed, "
                          "a pair's change is half of what the damping moves at the default speed. " + _PAIR_RULE,
                          section)
+    angles = section.get("angles")
+    if angles is None:
+        return lines
+    lines += ["**At the other angles** (`benchmarks/sweeps/rate_angles.toml`: RSF alpha and THF beta 0 and 30 "
+              "deg, every scope, at half the speed, against the main sweep's runs; not among the check's cases "
+              "above, shown because the loops behind a held tip form at every angle):", ""]
+    if not angles["ran"]:
+        return lines + [f"{NOT_RUN}: {angles['note']}", ""]
+    return lines + _pair_section(8, "", "", angles)[4:]
 
 
 def ringing(section):

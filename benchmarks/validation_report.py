@@ -171,6 +171,7 @@ def main(argv=None):
     for name, what in (("smoothness", "the smoothness sweep (benchmarks/sweeps/smoothness.toml)"),
                        ("gp-train", "the surrogate's training sweep (benchmarks/sweeps/gp_train.toml)"),
                        ("gp-test", "the surrogate's held-out sweep (benchmarks/sweeps/gp_test.toml)"),
+                       ("rate-angles", "the rate check at the other angles (benchmarks/sweeps/rate_angles.toml)"),
                        ("resistance", "the distal resistance sweep (colonsim sweep --preset resistance)")):
         parser.add_argument(f"--{name}-sweep", type=Path, default=None,
                             help=f"folder of {what}; its section says NOT RUN without it")
@@ -183,9 +184,9 @@ def main(argv=None):
     try:
         main_sweep = read_sweep("main", args.sweep)
         validation = read_sweep("validation", args.validation_sweep, preset="validation")
-        smooth, gp_train, gp_test, resisted = (read_sweep(label, folder, optional=True) for label, folder in (
+        smooth, gp_train, gp_test, resisted, angles = (read_sweep(label, folder, optional=True) for label, folder in (
             ("smoothness", args.smoothness_sweep), ("gp_train", args.gp_train_sweep), ("gp_test", args.gp_test_sweep),
-            ("resistance", args.resistance_sweep)))
+            ("resistance", args.resistance_sweep), ("rate_angles", args.rate_angles_sweep)))
     except ColonsimError as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 2
@@ -220,7 +221,8 @@ def main(argv=None):
            "mesh_pair": pair_section(validation, main_sweep, "mesh"),
            "rate_check": {**pair_section(validation, main_sweep, "rate"),
                           "speeds": (InsertionCase().push_speed, 0.5 * InsertionCase().push_speed),
-                          "held_share": InsertionCase().held_push_share},
+                          "held_share": InsertionCase().held_push_share,
+                          "angles": pair_section(angles, main_sweep, "rate")},
            "smoothness": {"cubic": smoothness.cubic_departures(smooth, out / "figures" / "smoothness.png"),
                           "figure": "figures/smoothness.png",
                           "surrogate": smoothness.surrogate_holdout(gp_train, gp_test)},
