@@ -89,8 +89,8 @@ def test_a_patient_runs_from_the_command_line(files, capsys):
 
 
 def test_case_checks_and_keys(files):
-    assert InsertionCase().key() == "32d7bb7c09a8"  # the quasi-static defaults, the 5 N distal resistance and the end at rest; see test_material_samples
-    assert InsertionCase(segment="rsf", scope="utc", angle_deg=30, friction=0.05).key() == "e23ea79f2b43"
+    assert InsertionCase().key() == "c9c1bc61c474"  # the quasi-static defaults, the 5 N distal resistance, the held push and the end at rest; see test_material_samples
+    assert InsertionCase(segment="rsf", scope="utc", angle_deg=30, friction=0.05).key() == "96523ce338e2"
     with pytest.raises(ColonsimError, match="use segment 'patient'"):
         InsertionCase(segment="rsj", centerline=str(files / "good.csv")).validate()
     case = InsertionCase(segment="patient", centerline=str(files / "good.csv"), scope="utc")
