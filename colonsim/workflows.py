@@ -146,7 +146,8 @@ def _format_result(r) -> str:
     if split is not None:
         lines.append(f"  the C10/C01 split is not identified by uniaxial data (correlation {split:+.3f}); mu0 carries their sum")
     ss = small_strain(r)
-    lines.append(f"  mu0 = {ss['mu0_Pa']:.1f} Pa, sd {ss['mu0_sd_Pa']:.1f} from the noise: {ss['identification']}")
+    sd = "inf" if ss["mu0_sd_Pa"] is None else f"{ss['mu0_sd_Pa']:.1f}"  # null in material.json: not identified
+    lines.append(f"  mu0 = {ss['mu0_Pa']:.1f} Pa, sd {sd} from the noise: {ss['identification']}")
     mf = ss["model_form"]
     if mf is not None:
         share = f" = {abs(mf['difference_in_noise_sd']):.1f} noise sd" if mf["difference_in_noise_sd"] is not None else ""

@@ -28,6 +28,7 @@ from colonsim.identification.hyperelastic import MODES, calibration_law
 from colonsim.identification.joint import JointResult
 from colonsim.identification.law_comparison import evidence, information_criteria
 from colonsim.identification.report import MATERIAL_FORMAT
+from colonsim.identification.uncertainty import sd_for_json
 from colonsim.provenance import code_version
 
 _MODE_COLOURS = {"uniaxial": "tab:blue", "equibiaxial": "tab:orange", "planar": "tab:green"}
@@ -46,7 +47,7 @@ def material_document(result: JointResult, selection=None, level=0.95) -> dict:
                        f"{', '.join(dict.fromkeys(c.mode for c in result.curves))} (joint fit).",
         "units": "Pa", "parameter_units": dict(zip(law.parameter_names, law.units)),
         "parameters": result.parameter_dict,
-        "small_strain": {"mu0_Pa": mu0, "mu0_sd_Pa": mu0_sd, "E0_Pa": 3.0 * mu0},
+        "small_strain": {"mu0_Pa": mu0, "mu0_sd_Pa": sd_for_json(mu0_sd), "E0_Pa": 3.0 * mu0},  # null: not identified
         "warnings": [warning] if warning else [],
         "stability": result.stability.to_dict(),
         "uncertainty": {k: v for k, v in unc.items() if k not in ("correlation", "covariance")},

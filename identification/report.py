@@ -29,6 +29,7 @@ from colonsim.identification.stability import StabilityCheck, check_stability, d
 from colonsim.laws import get_law
 from colonsim.identification.pipeline import CalibrationResult
 from colonsim.identification.testdata import source_records
+from colonsim.identification.uncertainty import sd_for_json
 
 MATERIAL_FORMAT = "colonsim-material/1"
 _STAGE_COLOURS = {"initial": "k", "sensitivity": "tab:gray", "cma-es": "tab:blue", "nelder-mead": "tab:red"}
@@ -43,9 +44,9 @@ def small_strain(result: CalibrationResult) -> dict:
     model_form = None
     if fe is not None and cf is not None:
         model_form = {"mu0_clamped_fe_Pa": fe, "mu0_closed_form_Pa": cf, "difference_Pa": fe - cf,
-                      "difference_in_noise_sd": (fe - cf) / mu0_sd if mu0_sd > 0 else None,
+                      "difference_in_noise_sd": (fe - cf) / mu0_sd if 0 < mu0_sd < np.inf else None,
                       "how": mc["mu0_refit"]}
-    return {"mu0_Pa": mu0, "mu0_sd_Pa": mu0_sd, "E0_Pa": 3.0 * mu0, "mu0_sd_covers": "measurement noise only",
+    return {"mu0_Pa": mu0, "mu0_sd_Pa": sd_for_json(mu0_sd), "E0_Pa": 3.0 * mu0, "mu0_sd_covers": "measurement noise only",
             "identification": identification_words(mu0, mu0_sd, result.fit["follows_curve"]),
             "model_form": model_form}
 

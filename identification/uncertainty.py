@@ -33,6 +33,11 @@ UNBOUNDED_SD = 1.0  # a direction whose sd exceeds this many bound widths is not
 SHARE = 1e-6  # a parameter (or a combination) with a larger share in an unidentified direction has an infinite sd
 
 
+def sd_for_json(sd):
+    """A standard deviation as JSON holds it: a number, or null for an infinite one (not identified)."""
+    return float(sd) if np.isfinite(sd) else None
+
+
 @dataclass
 class FitUncertainty:
     """Linearised uncertainty of fitted parameters (all in Pa).
@@ -105,15 +110,11 @@ class FitUncertainty:
     def to_dict(self, level=0.95) -> dict:
         ci = self.interval(level)
         sd = self.std
-
-        def finite(x):
-            return float(x) if np.isfinite(x) else None  # JSON holds no infinity: null = not identified
-
         directions = [] if self.unidentified is None else self.unidentified
         return {
             "method": "linearised least squares: s^2 (J^T J)^-1 at the optimum, J by central differences, inverted "
                       "on the identified singular directions of the Jacobian scaled by the bound widths",
-            "std": {n: finite(sd[i]) for i, n in enumerate(self.names)},
+            "std": {n: sd_for_json(sd[i]) for i, n in enumerate(self.names)},
             f"ci{int(level * 100)}": {n: (ci[i].tolist() if np.isfinite(sd[i]) else None)
                                        for i, n in enumerate(self.names)},
             "unidentified": [{"direction_in_bound_widths": dict(zip(self.names, np.round(v, 6).tolist())),
