@@ -16,7 +16,7 @@ import pytest
 from colonsim.cli import main
 from colonsim.data import TENSILE_DIR
 from colonsim.errors import ColonsimError
-from colonsim.inputs import check_input, decode_text, read_input, read_input_text
+from colonsim.inputs import check_input, decode_text, read_input
 from colonsim.insertion.engine.material import REFERENCE_MATERIAL_PATH
 from colonsim.limits import DOCUMENT_MAX_BYTES, TEXT_FILE_MAX_BYTES
 
