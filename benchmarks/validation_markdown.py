@@ -7,6 +7,7 @@ import math
 from colonsim.files import atomic_path
 from colonsim.insertion.study.verification_rules import GROUPS
 from colonsim.markdown import md_table, num
+from validation_changes import markdown as changes_markdown
 from validation_resistance import markdown as resistance_markdown
 
 NOT_RUN = "**NOT RUN**"
@@ -409,6 +410,6 @@ def write_markdown(doc, path):
              + rate_check(doc["rate_check"]) + smoothness(doc["smoothness"])
              + flexure_sensitivity(doc["flexure_sensitivity"])
              + node_counts(doc["node_counts"]) + run_ends(doc["run_ends"]) + run_times(doc["run_times"])
-             + resistance_markdown(doc["resistance"]))
+             + resistance_markdown(doc["resistance"]) + changes_markdown(doc.get("changes")))
     with atomic_path(path) as tmp:
         tmp.write_text("\n".join(lines), encoding="utf-8")

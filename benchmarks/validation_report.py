@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import argparse
 import datetime
+import json
 import math
 import os
 import platform
@@ -40,6 +41,7 @@ from colonsim.insertion.case.insertion_case import InsertionCase
 from colonsim.insertion.case.outcomes import RINGING_LIMIT
 from colonsim.insertion.study.claims import evaluate_claims
 
+import validation_changes as changes
 import validation_checks as checks
 import validation_figures as figures
 import validation_sections as sections
@@ -147,6 +149,15 @@ def flexure_section(validation, main, out):
     return {"ran": True, "angles_deg": angles, "rows": sections.flexure_sensitivity(validation, main), "figures": figs}
 
 
+def read_previous(path):
+    """The previous report's document, for the section on what moved."""
+    try:
+        return json.loads(Path(path).read_text(encoding="utf-8"))
+    except (OSError, ValueError) as exc:
+        raise ColonsimError(f"--previous {path}: cannot read it as a report.json ({type(exc).__name__}); copy the "
+                            "landed one aside first: git show HEAD:docs/validation/report.json > previous.json") from None
+
+
 def _clean(value):
     """NaN/inf -> None so the JSON is strict."""
     if isinstance(value, dict):
@@ -175,6 +186,9 @@ def main(argv=None):
                        ("resistance", "the distal resistance sweep (colonsim sweep --preset resistance)")):
         parser.add_argument(f"--{name}-sweep", type=Path, default=None,
                             help=f"folder of {what}; its section says NOT RUN without it")
+    parser.add_argument("--previous", type=Path, default=None,
+                        help="the previous report's report.json (a copy: the new report replaces it); adds the "
+                             "section on what moved since, which says NOT RUN without it")
     parser.add_argument("--out", type=Path, default=Path("docs/validation"), help="output folder (default docs/validation)")
     parser.add_argument("--size", choices=("reduced", "full"), default="reduced",
                         help="verification at the CI test sizes and quick calibration budget, or at full size")
@@ -187,6 +201,7 @@ def main(argv=None):
         smooth, gp_train, gp_test, resisted, angles = (read_sweep(label, folder, optional=True) for label, folder in (
             ("smoothness", args.smoothness_sweep), ("gp_train", args.gp_train_sweep), ("gp_test", args.gp_test_sweep),
             ("resistance", args.resistance_sweep), ("rate_angles", args.rate_angles_sweep)))
+        previous = None if args.previous is None else read_previous(args.previous)
     except ColonsimError as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 2
@@ -231,6 +246,7 @@ def main(argv=None):
            "node_counts": sections.node_counts(),
            "run_ends": {"main": sections.run_ends(main_sweep), "validation": sections.run_ends(validation)},
            "run_times": {"rows": times, "summary": sections.run_time_summary(times)}, "figures": figs}
+    doc["changes"] = changes.changes(previous, _clean(doc))
     doc["timings"] = {"verification_s": t_verification, "calibration_s": t_calibration,
                       "total_s": time.perf_counter() - t0}
     doc = _clean(doc)

@@ -1,0 +1,168 @@
+"""What moved since the previous validation report: the same runs and checks read from two
+``report.json`` documents, matched by what they are (model, scope, inputs), never by run key (a
+key moves with every setting that enters it, so the same case at a new default has a new key).
+
+``validation_report.py --previous OLD/report.json`` adds the section; without it the section
+says NOT RUN. Copy the landed report's JSON aside first, since the new report replaces it:
+``git show HEAD:docs/validation/report.json > /tmp/previous_report.json``.
+"""
+
+from __future__ import annotations
+
+import math
+
+from colonsim.markdown import md_table, num
+
+NOT_RUN = "**NOT RUN**"
+MOVED = 0.01  # a relative change at least this large is listed as moved
+SMALL_CM = 0.05  # deformations below this (cm) are compared by their absolute change: a ratio of near-zeros means nothing
+MOVED_CM = 0.005  # ... and have moved when that is at least this large (cm)
+RSJ_QUANTITIES = (("A", "A_cm"), ("C", "C_cm"), ("final", "final_cm"), ("max", "max_cm"))
+RUN_QUANTITIES = (("final", "final_deformation_cm"), ("max", "max_deformation_cm"),
+                  ("peak contact", "peak_contact_force_N"), ("peak push", "peak_push_force_N"))
+
+
+def _change(before, after, small=None):
+    """(relative change, absolute change); the relative one None where ``before`` is below ``small``."""
+    if before is None or after is None:
+        return None, None
+    rel = None if (small is not None and abs(before) < small) or before == 0 else (after - before) / abs(before)
+    return rel, after - before
+
+
+def _moved(rel, absolute):
+    if rel is not None:
+        return abs(rel) >= MOVED
+    return absolute is not None and abs(absolute) >= MOVED_CM
+
+
+def _quantities(before, after, pairs):
+    out = []
+    for name, key in pairs:
+        rel, absolute = _change(before.get(key), after.get(key), SMALL_CM if key.endswith("_cm") else None)
+        out.append({"quantity": name, "before": before.get(key), "after": after.get(key), "change": rel,
+                    "absolute": absolute, "moved": _moved(rel, absolute)})
+    return out
+
+
+def _runs(previous, current):
+    """RSJ rows (by case) and the RSF/THF/fixed THF runs of the main sweep (by model, scope, inputs)."""
+    rows = []
+    old_rsj = {r["case"]: r for r in previous.get("rsj", {}).get("rows", [])}
+    for r in current.get("rsj", {}).get("rows", []):
+        o = old_rsj.get(r["case"])
+        if o is not None:
+            rows.append({"run": f"RSJ {r['case']}", "status": f"{o.get('status')} -> {r.get('status')}",
+                         "quantities": _quantities(o, r, RSJ_QUANTITIES)})
+    old_runs = {(r["segment"], r["role"], r["inputs"]): r for r in previous.get("flexure_models", {}).get("rows", [])}
+    for r in current.get("flexure_models", {}).get("rows", []):
+        o = old_runs.get((r["segment"], r["role"], r["inputs"]))
+        if o is not None:
+            rows.append({"run": f"{r['segment'].upper()} {r['scope']} {r['inputs']}",
+                         "status": f"{o.get('status')} -> {r.get('status')}",
+                         "quantities": _quantities(o, r, RUN_QUANTITIES)})
+    return rows
+
+
+def _verdicts(previous, current):
+    """Every pass/fail of the rate and mesh pairs whose verdict changed, and the counts."""
+    def pairs(doc):
+        found = {}
+        for name, section in (("rate", doc.get("rate_check", {})), ("mesh", doc.get("mesh_pair", {})),
+                              ("rate (other angles)", doc.get("rate_check", {}).get("angles", {}))):
+            for r in (section or {}).get("rows", []) or []:
+                for q in r.get("quantities", []):
+                    found[(name, r["segment"], r["scope"], r["inputs"], q["quantity"])] = q
+        return found
+
+    old, new = pairs(previous), pairs(current)
+    flips = [{"check": k[0], "run": f"{k[1].upper()} {k[2]} {k[3]}", "quantity": k[4],
+              "before": old[k]["change"], "after": new[k]["change"],
+              "verdict": f"{'pass' if old[k]['passed'] else 'FAIL'} -> {'pass' if new[k]['passed'] else 'FAIL'}"}
+             for k in new if k in old and old[k].get("passed") != new[k].get("passed")]
+
+    def count(d):
+        return {name: (sum(bool(q.get("passed")) for k, q in d.items() if k[0] == name),
+                       sum(1 for k in d if k[0] == name)) for name in ("rate", "mesh", "rate (other angles)")}
+
+    return flips, count(old), count(new)
+
+
+def _summaries(previous, current):
+    """The ringing summary and the smoothness and surrogate rows, before and after."""
+    rows = []
+    for label, path in (("main sweep: largest ringing ratio", ("ringing", "sweeps", "main", "largest")),
+                        ("main sweep: runs below the ringing limit", ("ringing", "sweeps", "main", "passed"))):
+        before, after = previous, current
+        for p in path:
+            before = (before or {}).get(p) if isinstance(before, dict) else None
+            after = (after or {}).get(p) if isinstance(after, dict) else None
+        rows.append({"what": label, "before": before, "after": after})
+    for label, part, key in (("smoothness: departure from a cubic, share of range", "cubic", "departure"),
+                             ("surrogate held-out RMSE, share of spread", "surrogate", "share")):
+        old = {r["output"]: r for r in previous.get("smoothness", {}).get(part, {}).get("rows", []) or []}
+        for r in current.get("smoothness", {}).get(part, {}).get("rows", []) or []:
+            if r["output"] in old:
+                before, after = old[r["output"]].get(key), r.get(key)
+                rows.append({"what": f"{label}: {r['output']}", "before": before, "after": after})
+    return rows
+
+
+def changes(previous: dict | None, current: dict) -> dict:
+    """The section's document: the runs whose numbers moved, the verdicts that flipped, the summaries."""
+    if previous is None:
+        return {"ran": False, "note": "pass --previous with the previous report's report.json"}
+    runs = _runs(previous, current)
+    flips, counts_before, counts_after = _verdicts(previous, current)
+    header = previous.get("header", {})
+    return {"ran": True, "previous": {"date": header.get("date"), "commit": header.get("commit"),
+                                      "sweeps": {k: v.get("code") for k, v in header.get("sweeps", {}).items()}},
+            "runs": runs, "moved": [r for r in runs if any(q["moved"] for q in r["quantities"])],
+            "flips": flips, "pair_counts": {"before": counts_before, "after": counts_after},
+            "summaries": _summaries(previous, current)}
+
+
+def _cell(q):
+    if q["before"] is None or q["after"] is None:
+        return "-"
+    if q["change"] is not None:
+        shown = f"{100 * q['change']:+.1f} %"
+    else:
+        shown = f"{q['absolute']:+.3f} abs."
+    return f"{num(q['before'])} -> {num(q['after'])} ({shown})"
+
+
+def markdown(section) -> list:
+    lines = ["## 15. Changes since the previous report", ""]
+    if not section or not section.get("ran"):
+        return lines + [f"{NOT_RUN}: {(section or {}).get('note', '')}", ""]
+    p = section["previous"]
+    code = "; ".join(f"{k}: " + ", ".join(f"`{c[:12]}`" for c in (v or {})) for k, v in p["sweeps"].items())
+    lines += [f"Against the report of {p['date']} (commit `{(p['commit'] or '')[:12]}`; sweeps' code {code}). "
+              "Runs are matched by model, scope and inputs. A quantity has moved when it changed by "
+              f"{100 * MOVED:g} % or more (deformations below {SMALL_CM:g} cm: by {MOVED_CM:g} cm or more, shown as the "
+              f"absolute change). Of the {len(section['runs'])} runs the report's tables show (RSJ at mu 0, every RSF, THF and "
+              f"fixed THF run), {len(section['moved'])} moved.", ""]
+    if section["moved"]:
+        rsj = [r for r in section["moved"] if r["run"].startswith("RSJ ")]
+        other = [r for r in section["moved"] if not r["run"].startswith("RSJ ")]
+        for group in (rsj, other):
+            if group:
+                names = [q["quantity"] for q in group[0]["quantities"]]
+                lines += [md_table(group, [("run", "run")] + [
+                    (n, (lambda i: lambda r: _cell(r["quantities"][i]))(i)) for i, n in enumerate(names)]), ""]
+    before, after = section["pair_counts"]["before"], section["pair_counts"]["after"]
+    lines += ["Pass counts of the pair checks (passed / compared quantities): " + "; ".join(
+        f"{name} {before[name][0]}/{before[name][1]} -> {after[name][0]}/{after[name][1]}" for name in after) + ".", ""]
+    if section["flips"]:
+        lines += [md_table(section["flips"], [("check", "check"), ("run", "run"), ("quantity", "quantity"),
+                                              ("change before", lambda r: _pct(r["before"])),
+                                              ("change now", lambda r: _pct(r["after"])), ("verdict", "verdict")]), ""]
+    if section["summaries"]:
+        lines += [md_table(section["summaries"], [("what", "what"), ("before", lambda r: num(r["before"])),
+                                                  ("now", lambda r: num(r["after"]))]), ""]
+    return lines
+
+
+def _pct(v):
+    return "-" if v is None or not math.isfinite(v) else f"{100 * v:+.1f} %"
