@@ -127,6 +127,8 @@ def _cell(q):
         return "-"
     if q["change"] is not None:
         shown = f"{100 * q['change']:+.1f} %"
+    elif not q["moved"]:
+        shown = "near 0, unchanged"
     else:
         shown = f"{q['absolute']:+.3f} abs."
     return f"{num(q['before'])} -> {num(q['after'])} ({shown})"

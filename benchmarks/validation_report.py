@@ -111,12 +111,15 @@ def resistance_section(sweep, out):
     return section
 
 
-def not_run_note(validation):
-    if validation.folder is None:
-        return ("no --validation-sweep given; run `colonsim sweep --preset validation --out DIR` and pass "
-                "--validation-sweep DIR.")
-    return (f"no results table in `{validation.folder}`; run `colonsim sweep --preset validation "
-            f"--out {validation.folder}`.")
+NOT_RUN_HOW = {"validation": ("--validation-sweep", "colonsim sweep --preset validation"),
+               "rate_angles": ("--rate-angles-sweep", "colonsim sweep benchmarks/sweeps/rate_angles.toml")}
+
+
+def not_run_note(sweep):
+    option, command = NOT_RUN_HOW[sweep.label]
+    if sweep.folder is None:
+        return f"no {option} given; run `{command} --out DIR` and pass {option} DIR."
+    return f"no results table in `{sweep.folder}`; run `{command} --out {sweep.folder}`."
 
 
 def pair_section(validation, main, check):
