@@ -31,7 +31,8 @@ Modelling choices (stated so they can be cited):
   length is pushed in (``"length_used"``), when the wall's largest stretch passes
   ``failure_stretch`` (``"wall_stretch"``), or when the tip jams (``"jam"``,
   :func:`colonsim.insertion.case.outcomes.jammed`; once the distal resistance has engaged, the
-  tip is held back, not jammed, even where it slides back out of the exit's first millimetres). A jam or a torn wall is an outcome: the summary says where and under which forces.
+  tip is held back, not jammed, even where it slides back out of the exit's first millimetres).
+  A jam or a torn wall is an outcome: the summary says where and under which forces.
 """
 
 from __future__ import annotations
