@@ -88,23 +88,25 @@ def _verdicts(previous, current):
     return flips, count(old), count(new)
 
 
+def _get(doc, *path):
+    """``doc[path[0]][path[1]]...``, None where a level is missing (an older report, a section not run)."""
+    for key in path:
+        doc = doc.get(key) if isinstance(doc, dict) else None
+    return doc
+
+
 def _summaries(previous, current):
     """The ringing summary and the smoothness and surrogate rows, before and after."""
-    rows = []
-    for label, path in (("main sweep: largest ringing ratio", ("ringing", "sweeps", "main", "largest")),
-                        ("main sweep: runs below the ringing limit", ("ringing", "sweeps", "main", "passed"))):
-        before, after = previous, current
-        for p in path:
-            before = (before or {}).get(p) if isinstance(before, dict) else None
-            after = (after or {}).get(p) if isinstance(after, dict) else None
-        rows.append({"what": label, "before": before, "after": after})
+    rows = [{"what": label, "before": _get(previous, "ringing", "sweeps", "main", key),
+             "after": _get(current, "ringing", "sweeps", "main", key)}
+            for label, key in (("main sweep: largest ringing ratio", "largest"),
+                               ("main sweep: runs below the ringing limit", "passed"))]
     for label, part, key in (("smoothness: departure from a cubic, share of range", "cubic", "departure"),
                              ("surrogate held-out RMSE, share of spread", "surrogate", "share")):
-        old = {r["output"]: r for r in previous.get("smoothness", {}).get(part, {}).get("rows", []) or []}
-        for r in current.get("smoothness", {}).get(part, {}).get("rows", []) or []:
+        old = {r["output"]: r for r in _get(previous, "smoothness", part, "rows") or []}
+        for r in _get(current, "smoothness", part, "rows") or []:
             if r["output"] in old:
-                before, after = old[r["output"]].get(key), r.get(key)
-                rows.append({"what": f"{label}: {r['output']}", "before": before, "after": after})
+                rows.append({"what": f"{label}: {r['output']}", "before": old[r["output"]].get(key), "after": r.get(key)})
     return rows
 
 

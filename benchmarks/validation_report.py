@@ -249,10 +249,10 @@ def main(argv=None):
            "node_counts": sections.node_counts(),
            "run_ends": {"main": sections.run_ends(main_sweep), "validation": sections.run_ends(validation)},
            "run_times": {"rows": times, "summary": sections.run_time_summary(times)}, "figures": figs}
-    doc["changes"] = changes.changes(previous, _clean(doc))
     doc["timings"] = {"verification_s": t_verification, "calibration_s": t_calibration,
                       "total_s": time.perf_counter() - t0}
     doc = _clean(doc)
+    doc["changes"] = changes.changes(previous, doc)  # both documents as JSON holds them (NaN -> null)
     write_json(out / "report.json", doc)
     write_markdown(doc, out / "report.md")
     for cl in claims:

@@ -111,7 +111,8 @@ def _describe(r) -> str:
     if r.uncertainty.unidentified_words():
         lines.append(f"  {r.uncertainty.unidentified_words()}")
     mu0, mu0_sd = r.mu0
-    lines.append(f"  mu0 = {mu0:.6g} Pa, sd {mu0_sd:.3g}" + ("" if math.isfinite(mu0_sd) else " (not identified: it has a share in the combination above)"))
+    unidentified = "" if math.isfinite(mu0_sd) else " (not identified: it has a share in the combination above)"
+    lines.append(f"  mu0 = {mu0:.6g} Pa, sd {mu0_sd:.3g}{unidentified}")
     for _, row in r.per_curve.iterrows():
         r2 = "-" if row["r2"] is None else f"{row['r2']:.4f}"
         lines.append(f"  {row['curve']:<24} {row['mode']:<11} weight {row['weight']:g}: R^2 {r2}, RMS {row['rms_Pa'] / 1e3:.4g} kPa "

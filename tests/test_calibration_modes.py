@@ -169,7 +169,6 @@ def test_an_ogden_material_file_loads_for_the_insertion(tmp_path):
     assert material.mu0 == pytest.approx(doc["small_strain"]["mu0_Pa"], rel=1e-12)
 
 
-
 def test_a_material_file_is_written_when_mu0_is_not_identified(tmp_path, capsys):
     """Three Ogden terms on the colon strips' mean curve (uniaxial, to stretch 1.6) leave one
     combination of the parameters unfixed, and mu0 has a share in it: its sd is infinite, written
@@ -183,6 +182,7 @@ def test_a_material_file_is_written_when_mu0_is_not_identified(tmp_path, capsys)
     assert doc["uncertainty"]["unidentified"] and doc["small_strain"]["mu0_sd_Pa"] is None
     assert doc["small_strain"]["mu0_Pa"] == pytest.approx(84658.7, rel=1e-4)
     assert "mu0 = 84658.7 Pa, sd inf (not identified" in capsys.readouterr().out
+
 
 # The bundled colon calibration (mean curve, closed form, quick budget, seed 1) before the
 # multi-mode work: parameters (Pa) and evaluations must not move, nor its time.
