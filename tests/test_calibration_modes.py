@@ -122,7 +122,8 @@ def test_cli_joint_fit_and_one_line_errors(tmp_path, capsys):
     doc = json.loads((tmp_path / "nh" / "material.json").read_text())
     assert doc["law"] == "neo_hookean" and doc["stability"]["stable"] and doc["fit"]["curves"][0]["mode"] == "planar"
     assert (tmp_path / "nh" / "modes.png").is_file()
-    capsys.readouterr()
+    out = capsys.readouterr().out
+    assert "mu0 = " in out and "not identified" not in out and doc["small_strain"]["mu0_sd_Pa"] > 0  # one parameter, fixed
     plain = _table(tmp_path, "stretch,stress [MPa]\n1.1,1\n1.2,2\n1.3,3\n")
     assert main(["calibrate", "--curve", str(plain), "--mode", "planar", "--out", str(tmp_path / "x")]) == 2
     err = capsys.readouterr().err.strip().splitlines()
