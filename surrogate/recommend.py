@@ -17,6 +17,11 @@ the question is which scope deforms this colon less on average, not which of two
   surrogate part (the mean GP variance), and the probabilities are those of the mixture (the
   tissue moves all scopes together, so it widens each level far more than the differences).
 
+Each scope's sd and 95 % interval, by contrast, are those of a *new simulation result* at the
+patient's inputs (trend and scatter, the same numbers ``predict`` prints): that is what the
+held-out check (``surrogate validate``) scores, so the interval printed beside a scope is the one
+whose coverage has been measured. ``std_trend`` keeps the trend's own sd.
+
 Where the patient coincides with simulated cases, the posterior of the trend is nearly exact and
 the probabilities above approach 0 or 1: they then restate the simulations, not the surrogate's
 accuracy. The ``..._with_cv_error`` variants add to every scope an independent error with the
@@ -30,7 +35,7 @@ import numpy as np
 from scipy.special import ndtr
 
 from colonsim.errors import ColonsimError
-from colonsim.surrogate.tissue import plan, trend_components
+from colonsim.surrogate.tissue import plan, split_predict, trend_components
 from colonsim.surrogate.table import NAMED_SCOPES_MM, PAIN_PROXY, STANDARD_SCOPE, scope_diameter_mm, target_unit
 from colonsim.surrogate.validation import Z95
 
@@ -46,7 +51,8 @@ def recommend(model, segment, inputs: dict, scopes=None, target=PAIN_PROXY, refe
               strict=False, n_draws=20000, seed=0) -> dict:
     """Scopes for a patient (``inputs`` without the scope) ranked by predicted ``target``.
 
-    Returns a JSON-ready dict: per scope the mean, std and 95 % interval of the trend, the rank,
+    Returns a JSON-ready dict: per scope the mean, std and 95 % interval of a new simulation result
+    (and the trend's sd, ``std_trend``), the rank,
     ``p_best`` and ``p_less_than_reference``; overall ``p_ranking``; the domain check."""
     domain, gp = model.model_for(segment, target)
     if "scope_diameter_mm" not in domain.inputs:
@@ -84,11 +90,11 @@ def recommend(model, segment, inputs: dict, scopes=None, target=PAIN_PROXY, refe
     noisy = draws + np.random.default_rng(seed + 1).normal(0.0, cv_rmse, size=draws.shape)
     p_ranking_cv = float(np.mean(np.all(np.diff(noisy[:, order], axis=1) > 0, axis=1)))
     p_less_cv = np.mean(noisy < noisy[:, [r]], axis=0)
-    std = np.sqrt(var)
-    std_tissue = np.sqrt(np.maximum(np.diag(tissue_cov), 0.0)) if tissue.modelled else np.full(len(scopes), np.nan)
-    std_surrogate = np.sqrt(np.maximum(np.diag(surrogate_cov), 0.0))
+    # a new run's spread at each scope (trend + scatter, split into tissue and surrogate parts), as predict gives it
+    _, std, std_tissue, std_surrogate = split_predict(gp, domain, X, tissue)
+    std_trend = np.sqrt(var)
     rows = [{"scope": scopes[i], "diameter_mm": float(diameters[i]), "rank": int(np.flatnonzero(order == i)[0]) + 1,
-             "mean": float(mean[i]), "std": float(std[i]),
+             "mean": float(mean[i]), "std": float(std[i]), "std_trend": float(std_trend[i]),
              "std_tissue": None if np.isnan(std_tissue[i]) else float(std_tissue[i]),
              "std_surrogate": float(std_surrogate[i]), "low95": float(mean[i] - Z95 * std[i]),
              "high95": float(mean[i] + Z95 * std[i]), "p_best": float(p_best[i]),
@@ -98,15 +104,16 @@ def recommend(model, segment, inputs: dict, scopes=None, target=PAIN_PROXY, refe
     unknown = model.error_unknown(domain.segment, target)
     if unknown:  # the order stands by the means; no spread or probability the model cannot vouch for
         for row in rows:
-            row.update({k: None for k in ("std", "std_tissue", "std_surrogate", "low95", "high95", "p_best",
+            row.update({k: None for k in ("std", "std_trend", "std_tissue", "std_surrogate", "low95", "high95", "p_best",
                                           "p_less_than_reference", "p_less_than_reference_with_cv_error")})
         p_ranking = p_ranking_cv = None
     return {"segment": domain.segment, "target": target, "inputs": patient, "error_unknown": unknown,
             "n_runs": int(model.cv_[domain.segment][target]["n"]),
             "reference": reference, "ranking": [scopes[i] for i in order], "p_ranking": p_ranking,
             "cv_rmse": cv_rmse, "p_ranking_with_cv_error": p_ranking_cv, "scopes": rows,
-            "uncertainty": "joint GP posterior of the smooth trend at the scopes (covariance included); "
-                           "run-to-run scatter excluded", "in_domain": bool(inside.all()), "tissue": tissue.to_dict()}
+            "uncertainty": "intervals: a new simulation result at these inputs (trend + run-to-run scatter, as predict); "
+                           "probabilities: joint GP posterior of the smooth trend at the scopes (covariance included), "
+                           "scatter excluded", "in_domain": bool(inside.all()), "tissue": tissue.to_dict()}
 
 
 def _mixture_draws(means, covs, n_draws, seed):

@@ -212,6 +212,39 @@ def test_recommend_ranks_by_diameter_with_confidence(model):
     assert by_scope["utc"]["p_less_than_reference_with_cv_error"] <= by_scope["utc"]["p_less_than_reference"] + 0.01
 
 
+def test_recommend_prints_the_interval_of_a_new_run_which_is_wider_than_the_trends(model):
+    """The interval beside each scope is predict's (trend + scatter: what held-out runs score);
+    on a noisy table it is wider than the trend's own, and where the scatter is nil they agree."""
+    inputs = patient_inputs("rsj", age="middle", region="european")
+    rec = recommend(model, "rsj", inputs)
+    for s in rec["scopes"]:
+        mean, sd = model.predict({**inputs, "scope": s["scope"]}, "rsj", return_std=True)
+        assert s["mean"] == pytest.approx(mean[0], rel=1e-9) and s["std"] == pytest.approx(sd[0], rel=1e-9)
+        assert s["high95"] == pytest.approx(mean[0] + 1.959964 * sd[0], rel=1e-6)
+        assert s["std"] > 1.5 * s["std_trend"]  # the table scatters by 0.02 cm about a smooth trend
+
+    class NoScatter:  # the same trend with no white noise: a new run is the trend
+        def predict(self, X, return_std=False, return_cov=False):
+            mean, cov = gp.predict(X, return_cov=True)
+            if return_cov:
+                return mean, cov
+            return (mean, np.sqrt(np.diag(cov))) if return_std else mean
+
+    domain, gp = model.model_for("rsj", "max_deformation_cm")
+
+    class Quiet:
+        cv_, tissue_ = model.cv_, None
+
+        def model_for(self, segment, target):
+            return domain, NoScatter()
+
+        def error_unknown(self, segment, target):
+            return None
+
+    quiet = recommend(Quiet(), "rsj", inputs)
+    assert all(s["std"] == pytest.approx(s["std_trend"], rel=1e-9) for s in quiet["scopes"])
+
+
 def test_recommend_is_unsure_when_the_scope_does_not_matter():
     table = synthetic_sweep(design="grid", segments=("rsj",), noise_cm=0.05, seed=3)
     table["max_deformation_cm"] = 3.0 + 0.02 * table["diameter_mm"] + np.random.default_rng(0).normal(0, 0.05, len(table))
