@@ -9,11 +9,8 @@ says NOT RUN. Copy the landed report's JSON aside first, since the new report re
 
 from __future__ import annotations
 
-import math
+from colonsim.markdown import NOT_RUN, md_table, num, percent
 
-from colonsim.markdown import md_table, num
-
-NOT_RUN = "**NOT RUN**"
 MOVED = 0.01  # a relative change at least this large is listed as moved
 SMALL_CM = 0.05  # deformations below this (cm) are compared by their absolute change: a ratio of near-zeros means nothing
 MOVED_CM = 0.005  # ... and have moved when that is at least this large (cm)
@@ -160,13 +157,9 @@ def markdown(section) -> list:
         f"{name} {before[name][0]}/{before[name][1]} -> {after[name][0]}/{after[name][1]}" for name in after) + ".", ""]
     if section["flips"]:
         lines += [md_table(section["flips"], [("check", "check"), ("run", "run"), ("quantity", "quantity"),
-                                              ("change before", lambda r: _pct(r["before"])),
-                                              ("change now", lambda r: _pct(r["after"])), ("verdict", "verdict")]), ""]
+                                              ("change before", lambda r: percent(r["before"], "+.1f")),
+                                              ("change now", lambda r: percent(r["after"], "+.1f")), ("verdict", "verdict")]), ""]
     if section["summaries"]:
         lines += [md_table(section["summaries"], [("what", "what"), ("before", lambda r: num(r["before"])),
                                                   ("now", lambda r: num(r["after"]))]), ""]
     return lines
-
-
-def _pct(v):
-    return "-" if v is None or not math.isfinite(v) else f"{100 * v:+.1f} %"

@@ -2,21 +2,11 @@
 
 from __future__ import annotations
 
-import math
-
 from colonsim.files import atomic_path
 from colonsim.insertion.study.verification_rules import GROUPS
-from colonsim.markdown import md_table, num
+from colonsim.markdown import NOT_RUN, md_table, num, percent
 from validation_changes import markdown as changes_markdown
 from validation_resistance import markdown as resistance_markdown
-
-NOT_RUN = "**NOT RUN**"
-
-
-def pct(v, digits=2):
-    if v is None or not math.isfinite(v):
-        return "-"
-    return f"{100 * v:+.{digits}g} %"
 
 
 def verdict(passed):
@@ -71,7 +61,7 @@ def verification(rows):
             ("quantity", "quantity"),
             ("analytic", lambda r: num(r["analytic"]) + (f" {r['unit']}" if r["unit"] and r["analytic"] is not None else "")),
             ("measured", lambda r: num(r["measured"]) + (f" {r['unit']}" if r["unit"] else "")),
-            ("rel. error", lambda r: pct(r["relative_error"])), ("rule", "rule"), ("also measured", details),
+            ("rel. error", lambda r: percent(r["relative_error"])), ("rule", "rule"), ("also measured", details),
             ("why", "why"), ("result", lambda r: verdict(r["passed"]))]), ""]
         if group == "rod":
             lines += ["![buckling](figures/buckling.png)", "",
@@ -221,7 +211,7 @@ def _pair_section(number, title, intro, section):
     for q in PAIR_SHOWN:
         cols += [(f"{q}", lambda r, q=q: f"{num(r[f'base_{q}'])} / {num(r[f'variant_{q}'])}"
                   if r[f"base_{q}"] is not None else "-"),
-                 (f"change {q}", lambda r, q=q: pct(r[f"change_{q}"]))]
+                 (f"change {q}", lambda r, q=q: percent(r[f"change_{q}"]))]
     cols += [("ringing", lambda r: " / ".join(num(v) for v in r.get("ringing_ratio") or []) or "-"),
              ("ended by", lambda r: " / ".join(r.get("ended_by") or []) or "-"),
              ("pass", lambda r: verdict(r["passed"]))]
@@ -299,7 +289,7 @@ def smoothness(section):
         lines += [f"{NOT_RUN}: no --smoothness-sweep.", ""]
     else:
         lines += [md_table(cubic["rows"], [("output", "output"), ("runs", "runs"), ("range", "range"),
-                                           ("largest departure / range", lambda r: pct(r["departure"])),
+                                           ("largest departure / range", lambda r: percent(r["departure"])),
                                            ("at scope [mm]", "at_scope_mm"), ("< 2 %", lambda r: verdict(r["passed"]))]),
                   "", f"![outputs against scope diameter]({section['figure']})", ""]
     lines += ["**A surrogate's held-out error** (`gp_train.toml`, 20 runs, fits the project's surrogate; "
@@ -318,12 +308,12 @@ def smoothness(section):
     else:
         lines += [md_table(gp["rows"], [("output", "output"), ("train / test runs", lambda r: f"{r['train_runs']} / "
                                                                                               f"{r['test_runs']}"),
-                                         ("RMSE", "rmse"), ("held-out sd", "spread"), ("RMSE / sd", lambda r: pct(r["share"])),
-                                         ("95 % coverage", lambda r: pct(r["coverage95"])),
+                                         ("RMSE", "rmse"), ("held-out sd", "spread"), ("RMSE / sd", lambda r: percent(r["share"])),
+                                         ("95 % coverage", lambda r: percent(r["coverage95"])),
                                          ("< 5 %", lambda r: verdict(r["passed"])),
-                                         ("both sweeps: LOO RMSE / sd", lambda r: pct(r["pooled_loo_share"])),
+                                         ("both sweeps: LOO RMSE / sd", lambda r: percent(r["pooled_loo_share"])),
                                          ("runs' scatter", "scatter"),
-                                         ("scatter / sd", lambda r: pct(r["scatter_share"]))]), ""]
+                                         ("scatter / sd", lambda r: percent(r["scatter_share"]))]), ""]
     return lines
 
 

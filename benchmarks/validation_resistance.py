@@ -18,7 +18,7 @@ import numpy as np
 from colonsim.insertion.case.insertion_case import InsertionCase
 from colonsim.insertion.case.outcomes import RINGING_LIMIT
 from colonsim.insertion.study.claims import evaluate_claims
-from colonsim.markdown import md_table, num
+from colonsim.markdown import NOT_RUN, md_table, num
 from validation_resistance_readings import claim_readings
 from validation_sweeps import role, scope_label
 
@@ -26,7 +26,6 @@ LEVELS_N = (0.0, 5.0, 10.0, 20.0)
 SHAPES_LEVEL_N = 10.0  # the level whose final shapes the section draws (the "typical")
 RATE_LIMITS = {"point_A_cm": 0.05, "point_C_cm": 0.05, "final_deformation_cm": 0.05, "max_deformation_cm": 0.05,
                "peak_contact_force_N": 0.10, "peak_push_force_N": 0.10}
-NOT_RUN = "**NOT RUN**"
 
 
 def _number(row, column):

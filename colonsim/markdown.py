@@ -6,6 +6,15 @@ import math
 
 import numpy as np
 
+NOT_RUN = "**NOT RUN**"  # a report section whose sweep or input was not given
+
+
+def percent(v, spec="+.2g"):
+    """A signed share as a percentage, '-' for None/NaN: ``percent(0.052)`` is '+5.2 %'."""
+    if v is None or not math.isfinite(v):
+        return "-"
+    return f"{100 * v:{spec}} %"
+
 
 def num(v, digits=4):
     """A number for a table: 4 significant digits, '-' for None/NaN."""
