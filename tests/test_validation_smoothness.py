@@ -1,0 +1,27 @@
+"""The smoothness check's scale (benchmarks/validation_smoothness.py): what the largest departure
+from a cubic in the scope diameter is when the runs only scatter about a smooth trend."""
+
+import sys
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "benchmarks"))
+
+import validation_smoothness as smoothness  # noqa: E402
+
+DIAMETERS = np.arange(9.0, 13.51, 0.5)  # benchmarks/sweeps/smoothness.toml
+
+
+def test_scatter_alone_gives_a_band_of_departures_and_a_crease_falls_outside_it():
+    band = smoothness.scatter_alone_band(DIAMETERS, draws=2000)
+    assert 0.5 < band["p05"] < band["p50"] < band["p95"] < 3.0
+    # a cubic fitted to 10 runs leaves 6 degrees of freedom: the largest of 10 residuals of sd
+    # about sqrt(6/10) is near 1.4 sd, and the band does not depend on the trend or the sd's unit
+    assert 1.2 < band["p50"] < 1.7
+    # a regime change (a square-root onset at 11 mm) under a scatter of 0.001 departs from the
+    # cubic by far more than scatter alone: the comparison can come out the other way
+    trend = 1.0 + 0.05 * DIAMETERS + 0.1 * np.sqrt(np.maximum(DIAMETERS - 11.0, 0.0))
+    y = trend + np.random.default_rng(1).normal(0.0, 0.001, DIAMETERS.size)
+    departure = np.max(np.abs(y - np.polyval(np.polyfit(DIAMETERS, y, 3), DIAMETERS)))
+    assert departure / 0.001 > band["p95"]
