@@ -1,6 +1,8 @@
 """What moved since the previous validation report: the same runs and checks read from two
 ``report.json`` documents, matched by what they are (model, scope, inputs), never by run key (a
 key moves with every setting that enters it, so the same case at a new default has a new key).
+The distal resistance sweep's runs (by model, scope, angle or diameter and level), its rate pairs
+and the source's claims reproduced per level are compared too, where both reports have them.
 
 ``validation_report.py --previous OLD/report.json`` adds the section; without it the section
 says NOT RUN. Copy the landed report's JSON aside first, since the new report replaces it:
@@ -14,9 +16,11 @@ from colonsim.markdown import NOT_RUN, md_table, num, percent
 MOVED = 0.01  # a relative change at least this large is listed as moved
 SMALL_CM = 0.05  # deformations below this (cm) are compared by their absolute change: a ratio of near-zeros means nothing
 MOVED_CM = 0.005  # ... and have moved when that is at least this large (cm)
+RESISTED_RATE = "rate (resistance sweep)"
 RSJ_QUANTITIES = (("A", "A_cm"), ("C", "C_cm"), ("final", "final_cm"), ("max", "max_cm"))
 RUN_QUANTITIES = (("final", "final_deformation_cm"), ("max", "max_deformation_cm"),
                   ("peak contact", "peak_contact_force_N"), ("peak push", "peak_push_force_N"))
+RESISTED_QUANTITIES = RUN_QUANTITIES + (("largest lag", "max_lag_cm"),)
 
 
 def _change(before, after, small=None):
@@ -61,6 +65,19 @@ def _runs(previous, current):
     return rows
 
 
+def _resisted_runs(previous, current):
+    """The distal resistance sweep's runs, matched by model, scope, where and level."""
+    def by_case(doc):
+        return {(r["segment"], r["role"], r["where"], r["level_N"]): r
+                for r in _get(doc, "resistance", "rows") or []}
+
+    old = by_case(previous)
+    return [{"run": f"{k[0].upper()} {r['scope']} {k[2]}, {k[3]:g} N", "sweep": "resistance",
+             "status": f"{old[k].get('ended_by')} -> {r.get('ended_by')}",
+             "quantities": _quantities(old[k], r, RESISTED_QUANTITIES)}
+            for k, r in by_case(current).items() if k in old]
+
+
 def _verdicts(previous, current):
     """Every pass/fail of the rate and mesh pairs whose verdict changed, and the counts."""
     def pairs(doc):
@@ -70,6 +87,9 @@ def _verdicts(previous, current):
             for r in (section or {}).get("rows", []) or []:
                 for q in r.get("quantities", []):
                     found[(name, r["segment"], r["scope"], r["inputs"], q["quantity"])] = q
+        for r in _get(doc, "resistance", "rate") or []:  # the rate check of the resistance sweep (10 N)
+            for quantity, q in (r.get("changes") or {}).items():
+                found[(RESISTED_RATE, r["segment"], r["scope"], f"{r['where']}, {r['level_N']:g} N", quantity)] = q
         return found
 
     old, new = pairs(previous), pairs(current)
@@ -80,7 +100,8 @@ def _verdicts(previous, current):
 
     def count(d):
         return {name: (sum(bool(q.get("passed")) for k, q in d.items() if k[0] == name),
-                       sum(1 for k in d if k[0] == name)) for name in ("rate", "mesh", "rate (other angles)")}
+                       sum(1 for k in d if k[0] == name))
+                for name in ("rate", "mesh", "rate (other angles)", RESISTED_RATE)}
 
     return flips, count(old), count(new)
 
@@ -92,12 +113,26 @@ def _get(doc, *path):
     return doc
 
 
+def _claims_reproduced(doc, part):
+    """Per distal resistance level, how many of the source's claims are reproduced."""
+    claims = _get(doc, "resistance", part) or []
+    levels = {level for c in claims for level in (c.get("levels") or {})}
+    return {level: sum(c["levels"].get(level, {}).get("verdict") == "REPRODUCED" for c in claims) for level in levels}
+
+
 def _summaries(previous, current):
-    """The ringing summary and the smoothness and surrogate rows, before and after."""
-    rows = [{"what": label, "before": _get(previous, "ringing", "sweeps", "main", key),
-             "after": _get(current, "ringing", "sweeps", "main", key)}
-            for label, key in (("main sweep: largest ringing ratio", "largest"),
-                               ("main sweep: runs below the ringing limit", "passed"))]
+    """The ringing summaries, the claims reproduced per level and the smoothness and surrogate rows."""
+    rows = [{"what": label, "before": _get(previous, *path), "after": _get(current, *path)}
+            for label, path in (("main sweep: largest ringing ratio", ("ringing", "sweeps", "main", "largest")),
+                                ("main sweep: runs below the ringing limit", ("ringing", "sweeps", "main", "passed")),
+                                ("resistance sweep: largest ringing ratio", ("resistance", "quasi_static", "largest")),
+                                ("resistance sweep: runs below the ringing limit",
+                                 ("resistance", "quasi_static", "below")))]
+    for part, quantity in (("claims", "final"), ("claims_largest", "largest")):
+        old, new = _claims_reproduced(previous, part), _claims_reproduced(current, part)
+        rows += [{"what": f"resistance sweep: the source's claims reproduced on the {quantity} deformation at "
+                          f"{level} N", "before": old.get(level), "after": new[level]}
+                 for level in sorted(new, key=float)]
     for label, part, key in (("smoothness: departure from a cubic, share of range", "cubic", "departure"),
                              ("surrogate held-out RMSE, share of spread", "surrogate", "share")):
         old = {r["output"]: r for r in _get(previous, "smoothness", part, "rows") or []}
@@ -111,7 +146,7 @@ def changes(previous: dict | None, current: dict) -> dict:
     """The section's document: the runs whose numbers moved, the verdicts that flipped, the summaries."""
     if previous is None:
         return {"ran": False, "note": "pass --previous with the previous report's report.json"}
-    runs = _runs(previous, current)
+    runs = _runs(previous, current) + _resisted_runs(previous, current)
     flips, counts_before, counts_after = _verdicts(previous, current)
     header = previous.get("header", {})
     return {"ran": True, "previous": {"date": header.get("date"), "commit": header.get("commit"),
@@ -138,16 +173,19 @@ def markdown(section) -> list:
     if not section or not section.get("ran"):
         return lines + [f"{NOT_RUN}: {(section or {}).get('note', '')}", ""]
     p = section["previous"]
+    n_resisted = sum(r.get("sweep") == "resistance" for r in section["runs"])
     code = "; ".join(f"{k}: " + ", ".join(f"`{c[:12]}`" for c in (v or {})) for k, v in p["sweeps"].items())
     lines += [f"Against the report of {p['date']} (commit `{(p['commit'] or '')[:12]}`; sweeps' code {code}). "
               "Runs are matched by model, scope and inputs. A quantity has moved when it changed by "
               f"{100 * MOVED:g} % or more (deformations below {SMALL_CM:g} cm: by {MOVED_CM:g} cm or more, shown as the "
-              f"absolute change). Of the {len(section['runs'])} runs the report's tables show (RSJ at mu 0, every RSF, THF and "
-              f"fixed THF run), {len(section['moved'])} moved.", ""]
+              f"absolute change). Of the {len(section['runs'])} runs the report's tables show in both (RSJ at mu 0, every RSF, THF and "
+              f"fixed THF run of the main sweep, and {n_resisted} of the distal resistance sweep), "
+              f"{len(section['moved'])} moved.", ""]
     if section["moved"]:
-        rsj = [r for r in section["moved"] if r["run"].startswith("RSJ ")]
-        other = [r for r in section["moved"] if not r["run"].startswith("RSJ ")]
-        for group in (rsj, other):
+        resisted = [r for r in section["moved"] if r.get("sweep") == "resistance"]
+        rsj = [r for r in section["moved"] if r["run"].startswith("RSJ ") and r not in resisted]
+        other = [r for r in section["moved"] if not r["run"].startswith("RSJ ") and r not in resisted]
+        for group in (rsj, other, resisted):
             if group:
                 names = [q["quantity"] for q in group[0]["quantities"]]
                 lines += [md_table(group, [("run", "run")] + [

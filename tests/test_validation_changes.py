@@ -32,7 +32,7 @@ def test_a_moved_run_and_a_flipped_verdict_are_listed_and_an_unmoved_run_is_not(
     assert section["flips"] == [{"check": "rate", "run": "RSF UTC (9.2 mm) alpha 45 deg, push 0.15 m/s",
                                  "quantity": "final", "before": 0.071, "after": 0.002, "verdict": "FAIL -> pass"}]
     text = "\n".join(changes.markdown(section))
-    assert "fixed THF run), 1 moved" in text and "FAIL -> pass" in text
+    assert "and 0 of the distal resistance sweep), 1 moved" in text and "FAIL -> pass" in text
 
 
 def test_near_zero_deformations_are_compared_by_their_absolute_change():
@@ -45,3 +45,36 @@ def test_near_zero_deformations_are_compared_by_their_absolute_change():
 
 def test_without_a_previous_report_the_section_says_not_run():
     assert "NOT RUN" in "\n".join(changes.markdown(changes.changes(None, report(1.0, 1.0, 0.0, "a"))))
+
+
+def resisted(final_10n, rate_change, thin_claim):
+    """A report with a distal resistance section: one RSF run at 10 N, its rate pair, two claims."""
+    run = {"segment": "rsf", "role": "utc", "where": "alpha 45 deg", "level_N": 10.0, "scope": "UTC (9.2 mm)",
+           "final_deformation_cm": final_10n, "max_deformation_cm": 3.6, "peak_contact_force_N": 70.0,
+           "peak_push_force_N": 11.0, "max_lag_cm": 11.9, "ended_by": "length_used"}
+    rate = {"segment": "rsf", "scope": "SDC (13.3 mm)", "where": "alpha 45 deg", "level_N": 10.0,
+            "changes": {"final_deformation_cm": {"change": rate_change, "limit": 0.05,
+                                                 "passed": abs(rate_change) < 0.05}}}
+    claims = [{"name": "a", "levels": {"10": {"verdict": "REPRODUCED"}}},
+              {"name": "b", "levels": {"10": {"verdict": "REPRODUCED" if thin_claim else "NOT REPRODUCED"}}}]
+    doc = report(1.54, 1.83, 0.0, "a")
+    doc["resistance"] = {"rows": [run], "rate": [rate], "claims": claims, "claims_largest": claims,
+                         "quasi_static": {"below": 120, "largest": 0.2}}
+    return doc
+
+
+def test_the_distal_resistance_runs_their_rate_pairs_and_claims_are_compared():
+    section = changes.changes(resisted(3.06, 0.012, False), resisted(3.52, 0.071, True))
+    moved = [r for r in section["moved"] if r.get("sweep") == "resistance"]
+    assert [r["run"] for r in moved] == ["RSF UTC (9.2 mm) alpha 45 deg, 10 N"]
+    assert abs(moved[0]["quantities"][0]["change"] - (3.52 / 3.06 - 1)) < 1e-9
+    assert section["flips"] == [{"check": "rate (resistance sweep)", "run": "RSF SDC (13.3 mm) alpha 45 deg, 10 N",
+                                 "quantity": "final_deformation_cm", "before": 0.012, "after": 0.071,
+                                 "verdict": "pass -> FAIL"}]
+    claims = {r["what"]: (r["before"], r["after"]) for r in section["summaries"] if "claims" in r["what"]}
+    assert claims["resistance sweep: the source's claims reproduced on the final deformation at 10 N"] == (1, 2)
+    text = "\n".join(changes.markdown(section))
+    assert "and 1 of the distal resistance sweep), 1 moved" in text and "3.06 -> 3.52 (+15.0 %)" in text
+    # unmoved: the same run at the same numbers is matched and not listed
+    same = changes.changes(resisted(3.06, 0.012, False), resisted(3.06, 0.012, False))
+    assert len(same["runs"]) == 3 and not same["moved"] and not same["flips"]
