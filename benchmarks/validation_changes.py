@@ -181,15 +181,15 @@ def markdown(section) -> list:
               f"absolute change). Of the {len(section['runs'])} runs the report's tables show in both (RSJ at mu 0, every RSF, THF and "
               f"fixed THF run of the main sweep, and {n_resisted} of the distal resistance sweep), "
               f"{len(section['moved'])} moved.", ""]
-    if section["moved"]:
-        resisted = [r for r in section["moved"] if r.get("sweep") == "resistance"]
-        rsj = [r for r in section["moved"] if r["run"].startswith("RSJ ") and r not in resisted]
-        other = [r for r in section["moved"] if not r["run"].startswith("RSJ ") and r not in resisted]
-        for group in (rsj, other, resisted):
-            if group:
-                names = [q["quantity"] for q in group[0]["quantities"]]
-                lines += [md_table(group, [("run", "run")] + [
-                    (n, (lambda i: lambda r: _cell(r["quantities"][i]))(i)) for i, n in enumerate(names)]), ""]
+    tables = {"rsj": [], "main": [], "resistance": []}  # one table each: their rows show different quantities
+    for r in section["moved"]:
+        tables["resistance" if r.get("sweep") == "resistance" else "rsj" if r["run"].startswith("RSJ ") else
+               "main"].append(r)
+    for group in tables.values():
+        if group:
+            names = [q["quantity"] for q in group[0]["quantities"]]
+            lines += [md_table(group, [("run", "run")] + [
+                (n, (lambda i: lambda r: _cell(r["quantities"][i]))(i)) for i, n in enumerate(names)]), ""]
     before, after = section["pair_counts"]["before"], section["pair_counts"]["after"]
     lines += ["Pass counts of the pair checks (passed / compared quantities): " + "; ".join(
         f"{name} {before[name][0]}/{before[name][1]} -> {after[name][0]}/{after[name][1]}" for name in after) + ".", ""]

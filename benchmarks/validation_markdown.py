@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import math
+
 from colonsim.files import atomic_path
 from colonsim.insertion.study.verification_rules import GROUPS
 from colonsim.markdown import NOT_RUN, md_table, num, percent
@@ -275,6 +277,14 @@ def ringing(section):
     return lines
 
 
+def _scatter_alone(cubic):
+    band = cubic.get("scatter_alone")
+    if not band:
+        return ""
+    return (f" Scatter alone (independent runs about a smooth trend, Monte Carlo at these diameters) gives a largest "
+            f"departure of {band['p05']:.2g} to {band['p95']:.2g} times its sd (5-95 %, median {band['p50']:.2g}).")
+
+
 def smoothness(section):
     lines = ["## 9. Smooth across inputs", "",
              "Rough outputs make every surrogate fitted on them plateau (docs/model.md, \"Time integration and "
@@ -285,23 +295,16 @@ def smoothness(section):
              "output's range over the runs. Pass: under 2 %. A regime change a cubic cannot follow shows here as a "
              "failure, and the figure shows where. Beside it, for scale, the departure against the runs' own "
              "scatter about a smooth trend (the noise sd the surrogate fitted on both GP sweeps estimates, table "
-             "below): 2 % of a small range can lie below the scatter.", ""]
+             "below): 2 % of a small range can lie below the scatter." + _scatter_alone(section["cubic"]), ""]
     cubic = section["cubic"]
     if not cubic["ran"]:
         lines += [f"{NOT_RUN}: no --smoothness-sweep.", ""]
     else:
-        band = cubic.get("scatter_alone")
-        if band:
-            lines[-2] += (f" Scatter alone (independent runs about a smooth trend, Monte Carlo at these diameters) "
-                          f"gives a largest departure of {band['p05']:.2g} to {band['p95']:.2g} times its sd (5-95 %, "
-                          f"median {band['p50']:.2g}).")
-        gp_rows = section["surrogate"].get("rows") or []
-        scatter = {r["output"]: r.get("scatter") for r in gp_rows}
+        scatter = {r["output"]: r.get("scatter") for r in section["surrogate"].get("rows") or []}
 
         def in_scatters(r):
-            noise = scatter.get(r.get("column"))
-            departure = r.get("departure_cm")
-            return "-" if not noise or departure is None or departure != departure else f"{departure / noise:.2g}"
+            noise, departure = scatter.get(r.get("column")), r.get("departure_cm")
+            return "-" if not noise or departure is None or not math.isfinite(departure) else f"{departure / noise:.2g}"
 
         lines += [md_table(cubic["rows"], [("output", "output"), ("runs", "runs"), ("range", "range"),
                                            ("largest departure / range", lambda r: percent(r["departure"])),

@@ -51,15 +51,14 @@ def cubic_departures(sweep, figure_path):
             rows.append({"output": label, "column": column, "runs": int(keep.sum()), "departure": math.nan,
                          "passed": None})
             continue
-        coef = np.polyfit(d[keep], y[keep], 3)
-        fit = np.polyval(coef, d[keep])
+        coef, residual = cubic_fit(d[keep], y[keep])
         spread = float(np.ptp(y[keep]))
         # an output that stays below 0.1 cm everywhere has no range to judge against (nothing
         # measurable, as in the claims: insertion/study/claims.py NO_DEFORMATION_CM)
         judged = float(np.abs(y[keep]).max()) >= NO_DEFORMATION_CM and spread > 0
-        departure_cm = float(np.max(np.abs(y[keep] - fit)))
+        departure_cm = float(np.max(np.abs(residual)))
         departure = departure_cm / spread if judged else math.nan
-        worst = float(d[keep][np.argmax(np.abs(y[keep] - fit))])
+        worst = float(d[keep][np.argmax(np.abs(residual))])
         rows.append({"output": label, "column": column, "runs": int(keep.sum()), "range": spread,
                      "departure": departure, "departure_cm": departure_cm if judged else math.nan,
                      "at_scope_mm": worst if judged else None,
@@ -69,14 +68,19 @@ def cubic_departures(sweep, figure_path):
     return {"ran": True, "rows": rows, "tolerance": CUBIC_TOLERANCE, "scatter_alone": scatter_alone_band(d)}
 
 
+def cubic_fit(d, y):
+    """The least-squares cubic in ``d`` through ``y``: its coefficients and the residuals."""
+    coef = np.polyfit(d, y, 3)
+    return coef, y - np.polyval(coef, d)
+
+
 def scatter_alone_band(d, draws=5000, seed=0):
     """What scatter alone gives: the largest departure from the least-squares cubic of outputs
     that are independent standard normal at the diameters ``d`` (a trend plus scatter of sd 1),
     as the 5 %, 50 % and 95 % points over ``draws`` Monte Carlo samples: a departure in units of
     the runs' scatter inside that band is what rerunning the same cases would show."""
     rng = np.random.default_rng(seed)
-    largest = [float(np.max(np.abs(y - np.polyval(np.polyfit(d, y, 3), d))))
-               for y in rng.standard_normal((draws, len(d)))]
+    largest = [float(np.max(np.abs(cubic_fit(d, y)[1]))) for y in rng.standard_normal((draws, len(d)))]
     return dict(zip(("p05", "p50", "p95"), np.percentile(largest, [5, 50, 95]).tolist()))
 
 

@@ -223,14 +223,14 @@ def test_recommend_prints_the_interval_of_a_new_run_which_is_wider_than_the_tren
         assert s["high95"] == pytest.approx(mean[0] + 1.959964 * sd[0], rel=1e-6)
         assert s["std"] > 1.5 * s["std_trend"]  # the table scatters by 0.02 cm about a smooth trend
 
+    domain, gp = model.model_for("rsj", "max_deformation_cm")
+
     class NoScatter:  # the same trend with no white noise: a new run is the trend
         def predict(self, X, return_std=False, return_cov=False):
             mean, cov = gp.predict(X, return_cov=True)
             if return_cov:
                 return mean, cov
             return (mean, np.sqrt(np.diag(cov))) if return_std else mean
-
-    domain, gp = model.model_for("rsj", "max_deformation_cm")
 
     class Quiet:
         cv_, tissue_ = model.cv_, None
