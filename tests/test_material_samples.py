@@ -117,9 +117,10 @@ def test_every_case_is_crossed_with_every_draw(tmp_path):
     # resume); they moved with the quasi-static defaults (0.3 m/s push, the scope's damping): those
     # are other runs, with the end at rest (stopped at once, brought to rest, stop_distance_mm 0), and
     # with the hold until the run has come to rest (settle_max_s, settle_lateral_damping 20 1/s), and
-    # with the held push (held_push_share 0.5 behind a tip the distal resistance holds)
-    assert InsertionCase().key() == "c9c1bc61c474"
-    assert InsertionCase(segment="rsf", scope="utc", angle_deg=30, friction=0.05).key() == "96523ce338e2"
+    # with the held push (held_push_share 0.5 behind a tip the distal resistance holds), and with the
+    # 0.15 m/s push
+    assert InsertionCase().key() == "017707d53ff5"
+    assert InsertionCase(segment="rsf", scope="utc", angle_deg=30, friction=0.05).key() == "3577433662e4"
 
 
 def test_population_uses_each_specimen_once_or_a_seeded_subset(tmp_path):
