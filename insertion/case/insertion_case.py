@@ -70,8 +70,9 @@ class InsertionCase:
     element_size_mm, scope_spacing_mm : float
         Wall triangle size and scope node spacing.
     push_speed : float
-        Plateau push speed, m/s (0.15: a quarter of the source's 0.6, the fastest push whose
-        results half the speed leaves unchanged; docs/model.md, "Time integration and damping").
+        Plateau push speed, m/s (0.15: a quarter of the source's 0.6; the loops behind a held
+        tip that failed the rate check at 0.3 agree between 0.15 and 0.075; docs/model.md, "The
+        default push speed halved").
     held_push_share : float
         Once the distal resistance holds the tip, the push goes on at this share of
         ``push_speed`` (0.5; 1: no change; docs/model.md, "Loading"): a loop forming behind a held
