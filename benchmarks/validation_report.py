@@ -38,6 +38,7 @@ from colonsim.errors import ColonsimError
 from colonsim.files import write_json
 from colonsim.provenance import code_version
 from colonsim.insertion.case.insertion_case import InsertionCase
+from colonsim.insertion.study.sweep_presets import HALF_SPEED
 from colonsim.insertion.case.outcomes import RINGING_LIMIT
 from colonsim.insertion.study.claims import evaluate_claims
 
@@ -238,7 +239,7 @@ def main(argv=None):
                                                           "validation": sections.ringing_rows(validation)}},
            "mesh_pair": pair_section(validation, main_sweep, "mesh"),
            "rate_check": {**pair_section(validation, main_sweep, "rate"),
-                          "speeds": (InsertionCase().push_speed, 0.5 * InsertionCase().push_speed),
+                          "speeds": (InsertionCase().push_speed, HALF_SPEED),
                           "held_share": InsertionCase().held_push_share,
                           "angles": pair_section(angles, main_sweep, "rate")},
            "smoothness": {"cubic": smoothness.cubic_departures(smooth, out / "figures" / "smoothness.png"),
