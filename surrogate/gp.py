@@ -5,8 +5,12 @@ trend whose per-input length scales say how strongly each input matters (a lengt
 1 = the output barely depends on that input), plus white noise for the run-to-run scatter of the
 simulations. Inputs are scaled to [0, 1] over ``input_range`` (default: the training data), the
 target is standardized. Hyperparameters maximize the log marginal likelihood (L-BFGS-B from a
-default start and quasi-random restarts, :func:`restarts_for`); prediction is numpy from the
-stored Cholesky factor.
+default start and quasi-random restarts, :func:`restarts_for`). Up to :data:`SMALL_FIT_RUNS` runs
+the prediction then integrates them out: it averages the GPs of :data:`hyperposterior.DRAWS
+<colonsim.surrogate.hyperposterior.DRAWS>` draws from the Laplace approximation of their posterior
+(:mod:`colonsim.surrogate.hyperposterior`), so its sd includes what a few runs leave unknown
+about the length scales and the noise; above, the maximum's hyperparameters alone (a plug-in, as
+many runs pin them down). Prediction is numpy from stored factors.
 
 Hand-written rather than scikit-learn's ``GaussianProcessRegressor`` configured as the same model,
 because it is faster at the same likelihood: the fit with hyperparameter optimisation 1.7-4x
@@ -23,6 +27,7 @@ from scipy.optimize import minimize
 from scipy.stats import qmc
 
 from colonsim.errors import ColonsimError
+from colonsim.surrogate.hyperposterior import DRAWS, Mixture, laplace_draws
 from colonsim.surrogate.kernel import matern52
 from colonsim.surrogate.likelihood import JITTER, log_marginal_likelihood
 
@@ -45,6 +50,15 @@ def restarts_for(n_runs, n_restarts=None) -> int:
     return SMALL_FIT_RESTARTS if n_runs <= SMALL_FIT_RUNS else LARGE_FIT_RESTARTS
 
 
+def draws_for(n_runs, hyperparameter_draws=None) -> int:
+    """Draws of the hyperparameters a fit on ``n_runs`` runs predicts with: ``hyperparameter_draws``
+    if given, else :data:`~colonsim.surrogate.hyperposterior.DRAWS` up to :data:`SMALL_FIT_RUNS`
+    runs and 0 (the maximum's hyperparameters alone) above."""
+    if hyperparameter_draws is not None:
+        return int(hyperparameter_draws)
+    return DRAWS if n_runs <= SMALL_FIT_RUNS else 0
+
+
 class GaussianProcess:
     """GP regression of one output on a few continuous inputs.
 
@@ -64,11 +78,17 @@ class GaussianProcess:
         Smallest standard deviation of the run-to-run scatter, target units (0: none). The
         lower bound of the noise variance becomes at least its square (the scatter measured by
         replicate runs, :mod:`colonsim.surrogate.replicates`).
+    hyperparameter_draws : int or None
+        Draws of the hyperparameters the prediction averages over (0: the maximum's alone); None:
+        :func:`draws_for` the number of runs. The attributes ``constant_``, ``length_scale_``,
+        ``noise_level_``, ``L_`` and ``alpha_`` are the maximum's either way.
     """
 
     def __init__(self, input_range=None, constant_bounds=(1e-2, 1e2), length_scale_bounds=(1e-2, 1e2),
-                 noise_bounds=(1e-6, 1.0), n_restarts=None, random_state=0, noise_floor_sd=0.0):
+                 noise_bounds=(1e-6, 1.0), n_restarts=None, random_state=0, noise_floor_sd=0.0,
+                 hyperparameter_draws=None):
         self.input_range = input_range
+        self.hyperparameter_draws = hyperparameter_draws
         self.noise_floor_sd = noise_floor_sd
         self.constant_bounds = constant_bounds
         self.length_scale_bounds = length_scale_bounds
@@ -91,7 +111,16 @@ class GaussianProcess:
         ys = (y - self.y_mean_) / self.y_scale_
         theta = self._optimize(Xs, ys)
         self._condition(Xs, ys, theta)
+        n_draws = draws_for(len(ys), self.hyperparameter_draws)
+        self.set_draws(laplace_draws(theta, self._bounds(Xs.shape[1]), Xs, ys, n_draws, seed=self.random_state)
+                       if n_draws else np.zeros((0, len(theta))))
         return self
+
+    def set_draws(self, draws):
+        """Predict with the mixture over ``draws`` (log hyperparameters, one per row) of the GP
+        conditioned on the training runs; an empty array: the maximum's hyperparameters alone."""
+        self.draws_ = np.asarray(draws, dtype=float).reshape(-1, self.X_train_.shape[1] + 2)
+        self.mixture_ = Mixture(self.X_train_, self.y_train_, self.draws_) if len(self.draws_) else None
 
     def _bounds(self, d):
         low, high = self.noise_bounds
@@ -133,7 +162,8 @@ class GaussianProcess:
         return best.x
 
     def _condition(self, Xs, ys, theta):
-        """Store what prediction needs: training inputs, hyperparameters, Cholesky factor, alpha."""
+        """Store what prediction needs: training inputs, hyperparameters, Cholesky factor, alpha (the
+        plug-in at ``theta``; :meth:`set_draws` adds a mixture)."""
         self.X_train_ = Xs
         self.y_train_ = ys
         self.constant_ = float(np.exp(theta[0]))
@@ -143,6 +173,7 @@ class GaussianProcess:
         K[np.diag_indices_from(K)] += self.noise_level_ + JITTER
         self.L_ = cholesky(K, lower=True, check_finite=False)
         self.alpha_ = cho_solve((self.L_, True), ys, check_finite=False)
+        self.set_draws(np.zeros((0, len(theta))))  # conditioned anew: the plug-in until draws are set
 
     # -- prediction --------------------------------------------------------------------------------
     def scale(self, X):
@@ -157,6 +188,13 @@ class GaussianProcess:
         smooth trend at the rows (used to compare scopes for one patient); noise is never in it.
         """
         Xs = self.scale(np.atleast_2d(X))
+        if getattr(self, "mixture_", None) is not None:
+            if return_cov:
+                mean, cov = self.mixture_.predict(Xs, return_cov=True)
+                return self.y_mean_ + self.y_scale_ * mean, cov * self.y_scale_**2
+            mean, var = self.mixture_.predict(Xs)
+            mean = self.y_mean_ + self.y_scale_ * mean
+            return (mean, self.y_scale_ * np.sqrt(var)) if return_std else mean
         k = self.constant_ * matern52(Xs, self.X_train_, self.length_scale_)
         mean = self.y_mean_ + self.y_scale_ * (k @ self.alpha_)
         if not (return_std or return_cov):
@@ -185,4 +223,6 @@ class GaussianProcess:
     @property
     def kernel_description(self):
         ls = ", ".join(f"{v:.3g}" for v in self.length_scale_)
-        return f"{self.constant_:.3g} * Matern(length_scale=[{ls}], nu=2.5) + WhiteKernel({self.noise_level_:.3g})"
+        draws = len(getattr(self, "draws_", ()))
+        mixture = f", averaged over {draws} draws of the hyperparameters (Laplace)" if draws else ""
+        return f"{self.constant_:.3g} * Matern(length_scale=[{ls}], nu=2.5) + WhiteKernel({self.noise_level_:.3g}){mixture}"

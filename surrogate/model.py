@@ -62,10 +62,14 @@ class SweepSurrogate:
         Results table of training cases run again at another mesh or push speed: per output, the
         scatter of the pairs is the noise floor of its GP (:mod:`colonsim.surrogate.replicates`,
         ``scatter_``). None: no floor.
+    hyperparameter_draws : int or None
+        Draws of each GP's hyperparameters its predictions average over (0: the likelihood's
+        maximum alone, a plug-in); None: as many as the runs call for
+        (:func:`colonsim.surrogate.gp.draws_for`, :mod:`colonsim.surrogate.hyperposterior`).
     """
 
     def __init__(self, targets=TARGETS, inputs=INPUTS, segments=None, cv="loo", n_restarts=None, min_runs=4,
-                 random_state=0, threads=1, tissue=None, replicates=None):
+                 random_state=0, threads=1, tissue=None, replicates=None, hyperparameter_draws=None):
         self.targets = targets
         self.inputs = inputs
         self.segments = segments
@@ -76,10 +80,12 @@ class SweepSurrogate:
         self.threads = threads
         self.tissue = tissue
         self.replicates = replicates
+        self.hyperparameter_draws = hyperparameter_draws
 
     def _make_gp(self, domain, noise_floor_sd=0.0):
         return lambda: GaussianProcess(input_range=(domain.low, domain.high), n_restarts=self.n_restarts,
-                                       random_state=self.random_state, noise_floor_sd=noise_floor_sd)
+                                       random_state=self.random_state, noise_floor_sd=noise_floor_sd,
+                                       hyperparameter_draws=self.hyperparameter_draws)
 
     def fit(self, table: pd.DataFrame):
         """Fit every (segment, target) model on the runs with status "ok"; returns self."""
@@ -323,6 +329,8 @@ class SweepSurrogate:
                 else:
                     scales = ", ".join(f"{n} {v:.2g}" for n, v in zip(domain.inputs, gp.length_scale_))
                     about = f"scatter sd {gp.noise_std:.2g}  length scales ({scales})"
+                    if len(getattr(gp, "draws_", ())):
+                        about += f"  averaged over {len(gp.draws_)} hyperparameter draws"
                 lines.append(f"  {target:<22} n {cv['n']:>3}  CV RMSE {cv['rmse']:.3g}  max {cv['max_abs_error']:.3g}  "
                              f"95% coverage {100 * cv['coverage_95']:.0f} %  Q2 {cv['q2'] if cv['q2'] is None else round(cv['q2'], 3)}  "
                              f"{about}")

@@ -29,14 +29,16 @@ from colonsim.surrogate.domain import SegmentDomain
 from colonsim.surrogate.gp import GaussianProcess
 from colonsim.surrogate.larger import LargerOf
 from colonsim.surrogate.model import SweepSurrogate
-from colonsim.surrogate.store_checks import IDENTITY, arrays_path, check_domain, check_entry
+from colonsim.surrogate.store_checks import IDENTITY, arrays_path, check_domain, check_draws, check_entry
 from colonsim.surrogate.tissue import TissueDistribution
 
 FORMAT = "colonsim-surrogate"
 # 1.2: the noise floor and scatter of replicate runs; the arrays say which segment and output they belong to
 # 1.3: an output that is the larger of two others is stored as their names ("larger_of"), without arrays
-FORMAT_VERSION = "1.3"
+# 1.4: the draws of the hyperparameters the prediction averages over ("draws", absent or empty: none)
+FORMAT_VERSION = "1.4"
 ARRAYS = ("X_train", "y_train", "alpha", "L")
+DRAWS = "draws"  # (draws, inputs + 2) log hyperparameters; the mixture is rebuilt from them on reading
 
 
 def model_paths(path):
@@ -65,7 +67,7 @@ def save_surrogate(model: SweepSurrogate, path, source=None):
                 entries[target] = {"larger_of": list(gp.names), "n_train": gp.n_train,
                                    "cross_validation": model.cv_[seg][target], "scatter": model.scatter_[seg].get(target)}
                 continue
-            for name in ARRAYS:
+            for name in (*ARRAYS, DRAWS):
                 arrays[_key(seg, target, name)] = getattr(gp, name + "_")
             arrays[_key(seg, target, IDENTITY)] = np.array([seg, target])
             entries[target] = {
@@ -87,7 +89,7 @@ def save_surrogate(model: SweepSurrogate, path, source=None):
            "estimator": {"targets": list(model.targets), "inputs": list(model.inputs),
                          "segments": None if model.segments is None else list(model.segments), "cv": model.cv,
                          "n_restarts": model.n_restarts, "min_runs": model.min_runs, "random_state": model.random_state,
-                         "threads": model.threads},
+                         "threads": model.threads, "hyperparameter_draws": model.hyperparameter_draws},
            "training": model.training_, "notes": model.notes_, "segments": segments,
            "tissue": None if model.tissue_ is None else model.tissue_.to_dict()}
     bad = next((k for k, a in arrays.items() if a.dtype.kind == "f" and not np.isfinite(a).all()), None)
@@ -137,7 +139,8 @@ def _read_pair(doc, json_path, npz_path) -> SweepSurrogate:
         est = doc["estimator"]
         model = SweepSurrogate(targets=tuple(est["targets"]), inputs=tuple(est["inputs"]), segments=est["segments"],
                                cv=est["cv"], n_restarts=est["n_restarts"], min_runs=est["min_runs"],
-                               random_state=est["random_state"], threads=est.get("threads", 1))
+                               random_state=est["random_state"], threads=est.get("threads", 1),
+                               hyperparameter_draws=est.get("hyperparameter_draws"))
         model.training_, model.notes_ = doc["training"], list(doc["notes"])
         model.tissue_ = TissueDistribution.from_dict(doc.get("tissue"))  # files of format 1.0 hold none
         model.domains_, model.models_, model.cv_, model.skipped_, model.scatter_ = {}, {}, {}, {}, {}
@@ -163,6 +166,9 @@ def _read_pair(doc, json_path, npz_path) -> SweepSurrogate:
                     gp.log_marginal_likelihood_ = float(m["log_marginal_likelihood"])
                     for name in ARRAYS:
                         setattr(gp, name + "_", arrays[_key(seg, target, name)])
+                    draws = _key(seg, target, DRAWS)  # files of format 1.3 and older hold none
+                    gp.set_draws(check_draws(arrays[draws], len(domain.inputs), f"{json_path}: segment {seg}, {target}")
+                                 if draws in arrays.files else np.zeros((0, len(domain.inputs) + 2)))
                     model.models_[seg][target] = gp
                     model.cv_[seg][target] = m["cross_validation"]
                     model.scatter_[seg][target] = m.get("scatter")

@@ -97,3 +97,12 @@ def check_entry(segment, target, entry, domain, arrays, key, where):
                                 f"{shape} of finite numbers for {n} runs and {d} input(s); refit the surrogate")
     if not (np.diag(arrays[key("L")]) > 0).all():
         raise ColonsimError(f"{where}: the Cholesky factor L has a diagonal entry <= 0; refit the surrogate")
+
+
+def check_draws(draws, n_inputs, where):
+    """The stored draws of the log hyperparameters: finite, one column per hyperparameter."""
+    draws = np.asarray(draws)
+    if draws.ndim != 2 or draws.shape[1] != n_inputs + 2 or draws.dtype.kind != "f" or not np.isfinite(draws).all():
+        raise ColonsimError(f"{where}: array draws has shape {draws.shape} ({draws.dtype}), expected (draws, "
+                            f"{n_inputs + 2}) finite log hyperparameters; refit the surrogate")
+    return draws

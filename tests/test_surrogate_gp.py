@@ -28,7 +28,14 @@ def data():
 
 @pytest.fixture(scope="module")
 def fitted(data):
+    """The surrogate's GP: 60 runs, so its predictions average over draws of the hyperparameters."""
     return GaussianProcess(input_range=(np.zeros(3), np.ones(3)), n_restarts=1).fit(*data)
+
+
+@pytest.fixture(scope="module")
+def plug_in(data):
+    """The same fit predicting with the likelihood's maximum alone, the GP scikit-learn computes."""
+    return GaussianProcess(input_range=(np.zeros(3), np.ones(3)), n_restarts=1, hyperparameter_draws=0).fit(*data)
 
 
 def _sklearn_twin(gp):
@@ -48,7 +55,8 @@ def test_likelihood_and_gradient_match_sklearn(data):
     np.testing.assert_allclose(our_grad, grad, rtol=1e-7, atol=1e-9)
 
 
-def test_numpy_predictor_matches_sklearn_predict(fitted):
+def test_numpy_predictor_matches_sklearn_predict(plug_in):
+    fitted = plug_in
     sk = _sklearn_twin(fitted)
     Q = np.random.default_rng(0).uniform(-0.2, 1.2, (50, 3))
     mean, std = fitted.predict(Q, return_std=True)
@@ -72,17 +80,23 @@ def test_recovers_the_function_within_its_stated_accuracy(fitted):
     assert fitted.noise_std == pytest.approx(0.02, rel=0.5)
 
 
-def test_std_grows_away_from_the_data(fitted):
+@pytest.mark.parametrize("which", ["fitted", "plug_in"])
+def test_std_grows_away_from_the_data(which, request):
+    fitted = request.getfixturevalue(which)
     centre = np.array([[0.5, 0.5, 0.5]])
     far = [fitted.predict(centre + [[d, 0.0, 0.0]], return_std=True)[1][0] for d in (0.0, 1.0, 3.0, 10.0)]
     assert np.all(np.diff(far) > 0)
-    # far away the GP returns to its prior: mean of the data, sd of the data
+    # far away the GP returns to its prior: mean of the data, sd of the data (the mixture: the
+    # draws' prior variances averaged)
     mean, std = fitted.predict([[50.0, 50.0, 50.0]], return_std=True)
     assert mean[0] == pytest.approx(fitted.y_mean_, abs=1e-6)
-    assert std[0] == pytest.approx(fitted.y_scale_ * np.sqrt(fitted.constant_ + fitted.noise_level_), rel=1e-6)
+    prior = (np.exp(fitted.draws_[:, 0]) + np.exp(fitted.draws_[:, -1])).mean() if len(fitted.draws_) else \
+        fitted.constant_ + fitted.noise_level_
+    assert std[0] == pytest.approx(fitted.y_scale_ * np.sqrt(prior), rel=1e-6)
 
 
-def test_closed_form_loo_equals_refitting_without_each_run(fitted, data):
+def test_closed_form_loo_equals_refitting_without_each_run(plug_in, data):
+    fitted = plug_in
     X, y = data
     mean, std = loo_predictions(fitted)
     for i in (0, 17, 59):

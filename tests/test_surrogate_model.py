@@ -92,7 +92,7 @@ def test_out_of_domain_warns_and_strict_raises(model):
 def test_save_load_round_trip_without_pickle(model, tmp_path):
     json_path, npz_path = save_surrogate(model, tmp_path / "model", source="results.parquet")
     doc = json.loads(json_path.read_text())
-    assert doc["format"] == "colonsim-surrogate" and doc["format_version"] == "1.3"
+    assert doc["format"] == "colonsim-surrogate" and doc["format_version"] == "1.4"
     assert doc["segments"]["rsj"]["domain"]["fixed"]["angle_deg"] == 0.0
     assert set(doc["segments"]["rsj"]["models"]["max_deformation_cm"]["cross_validation"]) >= {
         "rmse", "max_abs_error", "coverage_95"}
@@ -101,6 +101,7 @@ def test_save_load_round_trip_without_pickle(model, tmp_path):
     with np.load(npz_path, allow_pickle=False) as arrays:  # no object arrays inside: numbers, and the identity text
         assert all(arrays[k].dtype == float for k in arrays.files if not k.endswith("__belongs_to"))
         assert arrays["rsj__max_deformation_cm__belongs_to"].tolist() == ["rsj", "max_deformation_cm"]
+        assert arrays["rsj__max_deformation_cm__draws"].shape == (16, 5)  # the hyperparameter draws, 3 inputs
     loaded = load_surrogate(json_path)
     rng = np.random.default_rng(2)
     q = {"scope_diameter_mm": rng.uniform(8, 14, 50), "diameter_mm": rng.uniform(20, 40, 50),
