@@ -36,6 +36,15 @@ PARTS = ("point_A_cm", "point_C_cm")
 BANDS = {"c95": (0.88, 0.99), "c50": (0.38, 0.62), "z_mean": (-0.3, 0.3), "z_sd": (0.7, 1.4)}
 
 
+def heldout_arguments(parser, replicates_required=True):
+    """The arguments of a held-out check: training sweeps, the held-out sweep, the replicates, sizes."""
+    parser.add_argument("--heldout", type=Path, nargs="+", required=True, help="training sweep folders (RSJ, in order)")
+    parser.add_argument("--test", type=Path, required=True, help="the held-out sweep folder")
+    parser.add_argument("--replicates", type=Path, required=replicates_required,
+                        help="training cases run again at another mesh or push speed (the noise floor)")
+    parser.add_argument("--train-sizes", type=int, nargs="+", default=[12, 20, 40])
+
+
 def table_of(folder) -> pd.DataFrame:
     path = Path(folder)
     table = read_results(path / "results.parquet" if path.is_dir() else path)
@@ -103,8 +112,10 @@ def replicate_pool(train, replicates, inputs=("scope_diameter_mm", "diameter_mm"
     return pd.concat([replicates, originals], ignore_index=True)
 
 
-def heldout(train_folders, test_folder, replicates_folder, sizes, restarts=None, figure=None, targets=TARGETS):
-    """Print the held-out scores; returns the scores of the model with the floor (for the figure)."""
+def heldout(train_folders, test_folder, replicates_folder, sizes, restarts=None, figure=None, targets=TARGETS,
+            draws=None):
+    """Print the held-out scores; returns the fitted models by (size, label). ``draws``: the
+    hyperparameter draws the predictions average over (None: the surrogate's default)."""
     folders = [table_of(f) for f in train_folders]
     train = pd.concat(folders, ignore_index=True)
     test = table_of(test_folder)
@@ -127,8 +138,10 @@ def heldout(train_folders, test_folder, replicates_folder, sizes, restarts=None,
                 continue
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore")
-                model = SweepSurrogate(targets=(*targets, *PARTS), n_restarts=restarts, replicates=reps).fit(runs)
-                one_gp = SweepSurrogate(targets=targets, n_restarts=restarts, replicates=reps).fit(runs)
+                model = SweepSurrogate(targets=(*targets, *PARTS), n_restarts=restarts, replicates=reps,
+                                       hyperparameter_draws=draws).fit(runs)
+                one_gp = SweepSurrogate(targets=targets, n_restarts=restarts, replicates=reps,
+                                        hyperparameter_draws=draws).fit(runs)
             models[(size, label)] = model
             fits = [(target, target, model) for target in targets]
             fits += [(target, f"{target} as one GP", one_gp) for target in targets

@@ -28,7 +28,6 @@ restarts over the leave-one-out refits (the surrogate's default is 32 up to 100 
 
 import argparse
 import warnings
-from pathlib import Path
 
 import numpy as np
 import pandas as pd
@@ -40,7 +39,7 @@ from colonsim.surrogate.holdout import score
 from colonsim.surrogate.likelihood import log_marginal_likelihood
 from colonsim.surrogate.model import SweepSurrogate
 from colonsim.surrogate.validation import loo_predictions
-from bench_heldout import replicate_pool, table_of, training_set
+from bench_heldout import heldout_arguments, replicate_pool, table_of, training_set
 
 LOO_GRID = 12  # noise values tried by loo-noise
 PROFILE_SD = (0.003, 0.0055, 0.0075, 0.01, 0.0125, 0.015, 0.02)  # noise sd at which the likelihood is profiled
@@ -206,10 +205,7 @@ def compare(train_folders, test_folder, replicates_folder, sizes, target, treatm
 
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--heldout", type=Path, nargs="+", required=True, help="training sweep folders (RSJ, in order)")
-    parser.add_argument("--test", type=Path, required=True, help="the held-out sweep folder")
-    parser.add_argument("--replicates", type=Path, required=True, help="training cases run again (mesh or push speed)")
-    parser.add_argument("--train-sizes", type=int, nargs="+", default=[12, 20, 40])
+    heldout_arguments(parser)
     parser.add_argument("--target", default="max_deformation_cm")
     parser.add_argument("--treatments", nargs="+", default=["ml", "ml+floor", "joint", "loo-noise"])
     parser.add_argument("--restarts", action="store_true", help="also: the optimum reached with 0-64 restarts")

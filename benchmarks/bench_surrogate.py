@@ -26,11 +26,13 @@ Part 3 (with ``--heldout``, :mod:`bench_heldout`): the surrogate fitted on train
 ``--train-sizes`` runs, without and with the noise floor of ``--replicates``, scored on the
 independent sweep ``--test``: interval coverage, standardized error and predicted orders against
 the acceptance bands, a reliability plot (``--figure``), and the query speed of the largest model
-(targets < 0.5 ms for one query, < 0.5 s for 10,000).
+(targets < 0.5 ms for one query, < 0.5 s for 10,000). ``--hyperparameter-draws 0`` scores the
+models that predict with the likelihood's maximum alone (the plug-in before 2026-11-27).
 
 Run: ``NUMBA_NUM_THREADS=1 python benchmarks/bench_surrogate.py [--sizes 40 150 500]
 [--results /work/sweeps/thesis2] [--restarts 2] [--target final_deformation_cm] [--model-runs 500]
-[--heldout TRAIN [TRAIN ...] --test TEST --replicates REPLICATES --train-sizes 12 20 40 --figure F.png]``
+[--heldout TRAIN [TRAIN ...] --test TEST --replicates REPLICATES --train-sizes 12 20 40 --figure F.png
+[--hyperparameter-draws N]]``
 (docs/surrogate.md, "Noise floor", gives the sweeps and the command).
 BLAS runs on one thread for both fits (as the surrogate's own fit). Needs scikit-learn, which is
 in the test extra (``pip install "colonsim[test]"``). On a shared machine timings vary by +-20 %.
@@ -233,12 +235,15 @@ def main():
     parser.add_argument("--replicates", type=Path, help="part 3: training cases run again (the noise floor)")
     parser.add_argument("--train-sizes", type=int, nargs="+", default=[12, 20, 40], help="part 3: training runs")
     parser.add_argument("--figure", type=Path, help="part 3: reliability plot of the model with the floor")
+    parser.add_argument("--hyperparameter-draws", type=int, help="part 3: draws the predictions average over "
+                        "(0: the likelihood's maximum alone; default: the surrogate's)")
     args = parser.parse_args()
     if args.heldout:
         if args.test is None:
             parser.error("--heldout needs --test")
         # part 3 fits as `colonsim surrogate fit` does, with the surrogate's own number of restarts
-        models = heldout(args.heldout, args.test, args.replicates, args.train_sizes, None, args.figure)
+        models = heldout(args.heldout, args.test, args.replicates, args.train_sizes, None, args.figure,
+                         draws=args.hyperparameter_draws)
         query_speed(models[max(models, key=lambda key: key[0])])
 
     # an optimum at a bound is normal here (a length scale of 100 = the output ignores that input)
