@@ -75,6 +75,9 @@ def add_parsers(sub):
     fit.add_argument("--cv", type=_cv, default="loo", help="'loo' (closed-form leave-one-out, default) or k folds")
     fit.add_argument("--restarts", type=bounded_int(0, 50),
                      help="extra optimizer starts per GP, 0-50 (default 32 up to 100 runs, 2 above)")
+    fit.add_argument("--hyperparameter-draws", type=bounded_int(0, 256),
+                     help="draws of each GP's hyperparameters its predictions average over, 0-256 (0: the "
+                          "likelihood's maximum alone; default 16 up to 100 runs, 0 above)")
     fit.add_argument("--min-runs", type=bounded_int(2, 20_000), default=4, help="fewest runs a model is fitted on (default 4)")
     fit.add_argument("--seed", type=seed, default=0, help="seed of the restarts and folds (default 0)")
     fit.add_argument("--material", type=Path, help=MATERIAL_HELP.replace("predictions average", "stored with the "
@@ -164,7 +167,8 @@ def cmd_fit(args):
     replicates = None if args.replicates is None else read_results(args.replicates)
     model = SweepSurrogate(targets=tuple(args.targets or TARGETS), segments=args.segments, cv=args.cv,
                            n_restarts=args.restarts, min_runs=args.min_runs, random_state=args.seed,
-                           threads=args.threads, tissue=tissue, replicates=replicates).fit(table)
+                           threads=args.threads, tissue=tissue, replicates=replicates,
+                           hyperparameter_draws=args.hyperparameter_draws).fit(table)
     json_path, npz_path = save_surrogate(model, args.out, source=args.results)
     print(model.report())
     print(f"model: {json_path} + {npz_path.name}")

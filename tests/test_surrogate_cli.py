@@ -25,6 +25,15 @@ def test_fit_writes_model_and_reports_cv(fitted, capsys):
     assert main(["surrogate", "info", str(fitted / "model.json")]) == 0
     text = capsys.readouterr().out
     assert "CV RMSE" in text and "95% coverage" in text and "rsf: 26 runs" in text
+    assert "averaged over 16 hyperparameter draws" in text  # the default up to 100 runs
+
+
+def test_fit_can_predict_with_the_likelihood_maximum_alone(fitted, capsys):
+    assert main(["surrogate", "fit", str(fitted / "results.parquet"), "-o", str(fitted / "plug"), "--restarts", "0",
+                 "--targets", "max_deformation_cm", "--hyperparameter-draws", "0"]) == 0
+    assert "hyperparameter draws" not in capsys.readouterr().out
+    doc = json.loads((fitted / "plug.json").read_text())
+    assert doc["estimator"]["hyperparameter_draws"] == 0
 
 
 def test_predict_json(fitted, capsys):
