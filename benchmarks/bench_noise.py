@@ -107,7 +107,9 @@ def make(treatment, floor_sd, pairs):
     floor = floor_sd if treatment in ("ml+floor", "loo-noise") else 0.0
 
     def factory(low, high):
-        gp = cls(input_range=(low, high), noise_floor_sd=floor)
+        # the noise treatments as measured (docs/surrogate.md "How the noise is chosen"): each with
+        # the likelihood's maximum alone, before the surrogate integrated its hyperparameters out
+        gp = cls(input_range=(low, high), noise_floor_sd=floor, hyperparameter_draws=0)
         gp.pairs = pairs
         return gp
 
