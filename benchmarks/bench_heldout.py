@@ -36,11 +36,11 @@ PARTS = ("point_A_cm", "point_C_cm")
 BANDS = {"c95": (0.88, 0.99), "c50": (0.38, 0.62), "z_mean": (-0.3, 0.3), "z_sd": (0.7, 1.4)}
 
 
-def heldout_arguments(parser, replicates_required=True):
+def heldout_arguments(parser):
     """The arguments of a held-out check: training sweeps, the held-out sweep, the replicates, sizes."""
     parser.add_argument("--heldout", type=Path, nargs="+", required=True, help="training sweep folders (RSJ, in order)")
     parser.add_argument("--test", type=Path, required=True, help="the held-out sweep folder")
-    parser.add_argument("--replicates", type=Path, required=replicates_required,
+    parser.add_argument("--replicates", type=Path, required=True,
                         help="training cases run again at another mesh or push speed (the noise floor)")
     parser.add_argument("--train-sizes", type=int, nargs="+", default=[12, 20, 40])
 

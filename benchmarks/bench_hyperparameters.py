@@ -11,16 +11,18 @@ intervals from the Gaussian with those moments, as the surrogate does for the la
 - ``plug-in``: the surrogate's GP before 2026-11-27 (maximum likelihood, noise floored at the
   replicate scatter, ``hyperparameter_draws=0``);
 - ``laplace F``: (the surrogate's today with F = 1 and 16 draws,
-  :mod:`colonsim.surrogate.hyperposterior`) draws from the Gaussian approximation of the posterior at the maximum, its
-  precision the negative Hessian of the log likelihood in the log hyperparameters (central
+  :func:`colonsim.surrogate.hyperposterior.laplace_draws`) draws from the Gaussian approximation of
+  the posterior at the maximum, its precision the negative Hessian of the log likelihood in the log hyperparameters (central
   differences of the analytic gradient), each eigenvalue raised to at least F (a direction the
   runs do not constrain gets at most a standard deviation of 1 / sqrt(F) in log units), the draws
   clipped to the fit's bounds;
 - ``mcmc``: an adaptive random-walk Metropolis chain on the log likelihood, a flat prior in the log
   hyperparameters within the fit's bounds, thinned to the same number of draws.
 
-Length scales below ``--ls-low`` (of the training range) are outside both posteriors: shorter than
-the spacing of a few dozen runs in three inputs, the runs cannot tell them from noise.
+Length scales below :data:`~colonsim.surrogate.hyperposterior.SHORTEST_LENGTH_SCALE` (0.1 of the
+training range) are outside both posteriors: shorter than the spacing of a few dozen runs in three
+inputs, the runs cannot tell them from noise. Every mixture is the surrogate's own
+(``GaussianProcess.set_draws``); only the draws differ.
 
 Per training size and output (point A, point C, final deformation, and the largest deformation as
 the larger of A and C): RMSE, coverage of the 50 / 90 / 95 % intervals and the mean and sd of the
@@ -33,16 +35,16 @@ Run: ``NUMBA_NUM_THREADS=1 python benchmarks/bench_hyperparameters.py --heldout 
 """
 
 import argparse
+import copy
 import time
 import warnings
 
 import numpy as np
 import pandas as pd
-from scipy.stats import qmc
 from threadpoolctl import threadpool_limits
 
 from colonsim.surrogate.gp import GaussianProcess
-from colonsim.surrogate.kernel import matern52
+from colonsim.surrogate.hyperposterior import SHORTEST_LENGTH_SCALE, laplace_draws
 from colonsim.surrogate.larger import larger_moments
 from colonsim.surrogate.likelihood import log_marginal_likelihood
 from colonsim.surrogate.replicates import replicate_scatter
@@ -53,36 +55,20 @@ PARTS = ("point_A_cm", "point_C_cm")
 TARGETS = (*PARTS, "final_deformation_cm")
 
 
-def bounds_of(gp, ls_low):
-    """The fit's bounds of the log hyperparameters, length scales from ``ls_low``."""
-    b = gp._bounds(gp.X_train_.shape[1])
-    b[1:-1, 0] = np.maximum(b[1:-1, 0], np.log(ls_low))
-    return b
-
-
 def map_theta(gp):
     return np.log(np.r_[gp.constant_, gp.length_scale_, gp.noise_level_])
 
 
-def laplace_draws(gp, n_draws, floor, ls_low, seed):
-    """Draws of the log hyperparameters from the Gaussian approximation at the maximum."""
-    theta, b = map_theta(gp), bounds_of(gp, ls_low)
-    p, h = len(theta), 1e-4
-    H = np.empty((p, p))
-    for i in range(p):
-        step = np.zeros(p)
-        step[i] = h
-        H[i] = (log_marginal_likelihood(theta + step, gp.X_train_, gp.y_train_)[1]
-                - log_marginal_likelihood(theta - step, gp.X_train_, gp.y_train_)[1]) / (2 * h)
-    w, V = np.linalg.eigh(-0.5 * (H + H.T))
-    cov = V @ np.diag(1.0 / np.maximum(w, floor)) @ V.T
-    draws = qmc.MultivariateNormalQMC(theta, cov, seed=seed).random(n_draws)
-    return np.clip(draws, b[:, 0], b[:, 1])
+def bounds_of(gp):
+    """The fit's bounds of the log hyperparameters, length scales from the surrogate's shortest."""
+    b = gp._bounds(gp.X_train_.shape[1])
+    b[1:-1, 0] = np.maximum(b[1:-1, 0], np.log(SHORTEST_LENGTH_SCALE))
+    return b
 
 
-def mcmc_draws(gp, n_draws, ls_low, seed, steps=6000, burn=2000):
+def mcmc_draws(gp, n_draws, seed, steps=6000, burn=2000):
     """Draws of the log hyperparameters from an adaptive Metropolis chain (flat prior in the bounds)."""
-    rng, b = np.random.default_rng(seed), bounds_of(gp, ls_low)
+    rng, b = np.random.default_rng(seed), bounds_of(gp)
 
     def log_post(t):
         inside = np.all(t >= b[:, 0]) and np.all(t <= b[:, 1])
@@ -102,28 +88,11 @@ def mcmc_draws(gp, n_draws, ls_low, seed, steps=6000, burn=2000):
     return chain[np.linspace(0, len(chain) - 1, n_draws).astype(int)]
 
 
-class Mixture:
-    """The GP's predictive averaged over draws of its log hyperparameters (first two moments)."""
-
-    def __init__(self, gp, thetas):
-        self.gp, self.parts = gp, []
-        for t in thetas:
-            c, ls, s = np.exp(t[0]), np.exp(t[1:-1]), np.exp(t[-1])
-            K = c * matern52(gp.X_train_, gp.X_train_, ls) + (s + 1e-10) * np.eye(gp.n_train)
-            L = np.linalg.cholesky(K)
-            Linv = np.linalg.inv(L)
-            self.parts.append((c, ls, s, Linv, Linv.T @ (Linv @ gp.y_train_)))
-
-    def predict(self, X):
-        Qs, means, variances = self.gp.scale(X), [], []
-        for c, ls, s, Linv, alpha in self.parts:
-            k = c * matern52(Qs, self.gp.X_train_, ls)
-            v = k @ Linv.T
-            means.append(k @ alpha)
-            variances.append(c - np.einsum("ij,ij->i", v, v) + s)
-        means, variances = np.array(means), np.array(variances)
-        mean, var = means.mean(axis=0), variances.mean(axis=0) + means.var(axis=0)
-        return self.gp.y_mean_ + self.gp.y_scale_ * mean, self.gp.y_scale_ * np.sqrt(var)
+def averaged(gp, draws):
+    """The fitted plug-in ``gp`` predicting as the mixture over ``draws`` (the surrogate's own code)."""
+    mixture = copy.copy(gp)
+    mixture.set_draws(draws)
+    return mixture
 
 
 def scored(y, mean, sd):
@@ -143,7 +112,6 @@ def main():
     heldout_arguments(p)
     p.add_argument("--draws", type=int, default=64, help="draws of the hyperparameters per mixture")
     p.add_argument("--floors", type=float, nargs="+", default=[0.01, 1.0], help="Laplace precision floors")
-    p.add_argument("--ls-low", type=float, default=0.1, help="shortest length scale drawn, of the training range")
     p.add_argument("--seed", type=int, default=0)
     args = p.parse_args()
     folders = [table_of(f) for f in args.heldout]
@@ -151,7 +119,7 @@ def main():
     # the replicates with every training run they repeat, as bench_heldout pairs them
     pool = replicate_pool(pd.concat(folders, ignore_index=True), table_of(args.replicates))
     Q = test[INPUTS].to_numpy(float)
-    print(f"held out: {args.test} ({len(test)} runs); draws {args.draws}, length scales >= {args.ls_low}")
+    print(f"held out: {args.test} ({len(test)} runs); draws {args.draws}, length scales >= {SHORTEST_LENGTH_SCALE}")
     with threadpool_limits(limits=1, user_api="blas"), warnings.catch_warnings():
         warnings.simplefilter("ignore")
         for size in args.train_sizes:
@@ -169,14 +137,14 @@ def main():
                                      hyperparameter_draws=0).fit(X, y)
                 models = {"plug-in": gp}
                 for f in args.floors:
-                    models[f"laplace {f:g}"] = Mixture(gp, laplace_draws(gp, args.draws, f, args.ls_low, args.seed))
-                models["mcmc"] = Mixture(gp, mcmc_draws(gp, args.draws, args.ls_low, args.seed))
-                predictions[target] = {name: (m.predict(Q, return_std=True) if m is gp else m.predict(Q))
-                                       for name, m in models.items()}
+                    models[f"laplace {f:g}"] = averaged(gp, laplace_draws(map_theta(gp), gp._bounds(X.shape[1]), gp.X_train_,
+                                                                          gp.y_train_, args.draws, f, args.seed))
+                models["mcmc"] = averaged(gp, mcmc_draws(gp, args.draws, args.seed))
+                predictions[target] = {name: m.predict(Q, return_std=True) for name, m in models.items()}
                 if target == TARGETS[0]:
                     start = time.perf_counter()
                     for _ in range(200):
-                        models["mcmc"].predict(Q[:1])
+                        models["mcmc"].predict(Q[:1], return_std=True)
                     query_ms = (time.perf_counter() - start) / 200 * 1e3
             print(f"\n{size} training runs (one query of a {args.draws}-draw mixture: {query_ms:.2f} ms per GP)")
             for name in treatments:

@@ -188,13 +188,14 @@ class GaussianProcess:
         smooth trend at the rows (used to compare scopes for one patient); noise is never in it.
         """
         Xs = self.scale(np.atleast_2d(X))
-        if getattr(self, "mixture_", None) is not None:
+        if self.mixture_ is not None:
             if return_cov:
                 mean, cov = self.mixture_.predict(Xs, return_cov=True)
                 return self.y_mean_ + self.y_scale_ * mean, cov * self.y_scale_**2
+            if not return_std:
+                return self.y_mean_ + self.y_scale_ * self.mixture_.predict(Xs, return_var=False)
             mean, var = self.mixture_.predict(Xs)
-            mean = self.y_mean_ + self.y_scale_ * mean
-            return (mean, self.y_scale_ * np.sqrt(var)) if return_std else mean
+            return self.y_mean_ + self.y_scale_ * mean, self.y_scale_ * np.sqrt(var)
         k = self.constant_ * matern52(Xs, self.X_train_, self.length_scale_)
         mean = self.y_mean_ + self.y_scale_ * (k @ self.alpha_)
         if not (return_std or return_cov):
@@ -223,6 +224,5 @@ class GaussianProcess:
     @property
     def kernel_description(self):
         ls = ", ".join(f"{v:.3g}" for v in self.length_scale_)
-        draws = len(getattr(self, "draws_", ()))
-        mixture = f", averaged over {draws} draws of the hyperparameters (Laplace)" if draws else ""
+        mixture = f", averaged over {len(self.draws_)} draws of the hyperparameters (Laplace)" if len(self.draws_) else ""
         return f"{self.constant_:.3g} * Matern(length_scale=[{ls}], nu=2.5) + WhiteKernel({self.noise_level_:.3g}){mixture}"

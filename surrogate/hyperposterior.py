@@ -36,7 +36,7 @@ from __future__ import annotations
 import numpy as np
 from scipy.stats import qmc
 
-from colonsim.surrogate.kernel import matern52, matern52_of_distance
+from colonsim.surrogate.kernel import matern52
 from colonsim.surrogate.likelihood import JITTER, log_marginal_likelihood
 
 DRAWS = 16  # draws of the hyperparameters (a power of 2: balanced Sobol points)
@@ -89,42 +89,40 @@ class Mixture:
             self.L_inv[i] = np.linalg.inv(np.linalg.cholesky(K))
             self.alpha[i] = self.L_inv[i].T @ (self.L_inv[i] @ y)
 
-    def _cross(self, Q):
-        """Each draw's covariance between the query rows ``Q`` (m, d) and the runs: (draws, m, n)."""
-        A = Q[None] / self.length_scale[:, None, :]
-        B = self.X[None] / self.length_scale[:, None, :]
-        sq = (np.einsum("kmd,kmd->km", A, A)[:, :, None] + np.einsum("knd,knd->kn", B, B)[:, None, :]
-              - 2.0 * A @ B.transpose(0, 2, 1))
-        return self.constant[:, None, None] * matern52_of_distance(np.sqrt(np.maximum(sq, 0.0)))
+    def _covariance(self, QA, QB):
+        """Each draw's prior covariance between the rows of ``QA`` and ``QB``: (draws, m, n)."""
+        return self.constant[:, None, None] * matern52(QA, QB, self.length_scale[:, None, :])
 
-    def predict(self, Q, return_cov=False):
-        """Mixture mean (m,) and the variance of a new result (m,) at scaled query rows ``Q``; with
-        ``return_cov``, the mean and the trend's joint covariance (m, m), noise excluded."""
+    def predict(self, Q, return_cov=False, return_var=True):
+        """Mixture mean (m,) and the variance of a new result (m,) at scaled query rows ``Q`` (the
+        mean alone without ``return_var``); with ``return_cov``, the mean and the trend's joint
+        covariance (m, m), noise excluded."""
         if return_cov:
-            k = self._cross(Q)
+            k = self._covariance(Q, self.X)
             means = np.einsum("kmn,kn->km", k, self.alpha)
             v = k @ self.L_inv.transpose(0, 2, 1)
-            covs = np.stack([c * matern52(Q, Q, ls) for c, ls in zip(self.constant, self.length_scale)])
-            covs -= v @ v.transpose(0, 2, 1)
+            covs = self._covariance(Q, Q) - v @ v.transpose(0, 2, 1)
             spread = means - means.mean(axis=0)
             return means.mean(axis=0), covs.mean(axis=0) + spread.T @ spread / len(means)
         if len(Q) >= ONE_THREAD_ROWS:
             from threadpoolctl import threadpool_limits
 
             with threadpool_limits(limits=1, user_api="blas"):
-                return self._predict_rows(Q)
-        return self._predict_rows(Q)
+                return self._predict_rows(Q, return_var)
+        return self._predict_rows(Q, return_var)
 
-    def _predict_rows(self, Q):
+    def _predict_rows(self, Q, return_var):
         mean, var = np.empty(len(Q)), np.empty(len(Q))
         for start in range(0, len(Q), QUERY_CHUNK):
             rows = slice(start, start + QUERY_CHUNK)
-            k = self._cross(Q[rows])
+            k = self._covariance(Q[rows], self.X)
             means = np.einsum("kmn,kn->km", k, self.alpha)
-            v = k @ self.L_inv.transpose(0, 2, 1)
-            variances = self.constant[:, None] - np.einsum("kmn,kmn->km", v, v) + self.noise[:, None]
-            mean[rows], var[rows] = means.mean(axis=0), np.maximum(variances, 0.0).mean(axis=0) + means.var(axis=0)
-        return mean, var
+            mean[rows] = means.mean(axis=0)
+            if return_var:
+                v = k @ self.L_inv.transpose(0, 2, 1)
+                variances = self.constant[:, None] - np.einsum("kmn,kmn->km", v, v) + self.noise[:, None]
+                var[rows] = np.maximum(variances, 0.0).mean(axis=0) + means.var(axis=0)
+        return (mean, var) if return_var else mean
 
     def leave_one_out(self, y):
         """Closed-form leave-one-out mean and variance of each run (each draw's, Rasmussen & Williams

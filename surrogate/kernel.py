@@ -16,11 +16,13 @@ SQRT5 = np.sqrt(5.0)
 
 def scaled_distance(XA, XB, length_scale):
     """Euclidean distance between the rows of ``XA`` (m, d) and ``XB`` (n, d), each input divided by
-    its length scale; (m, n)."""
+    its length scale; (m, n). Length scales of shape (k, 1, d) give one distance matrix per row
+    of them, (k, m, n)."""
     A = np.asarray(XA, dtype=float) / length_scale
     B = np.asarray(XB, dtype=float) / length_scale
     # |a - b|^2 = |a|^2 + |b|^2 - 2 a.b: one matrix product instead of an (m, n, d) tensor
-    sq = np.einsum("ij,ij->i", A, A)[:, None] + np.einsum("ij,ij->i", B, B)[None, :] - 2.0 * (A @ B.T)
+    sq = (np.einsum("...ij,...ij->...i", A, A)[..., :, None] + np.einsum("...ij,...ij->...i", B, B)[..., None, :]
+          - 2.0 * (A @ np.swapaxes(B, -1, -2)))
     return np.sqrt(np.maximum(sq, 0.0))
 
 
@@ -31,5 +33,6 @@ def matern52_of_distance(r):
 
 
 def matern52(XA, XB, length_scale):
-    """Matern 5/2 correlation matrix between the rows of ``XA`` and ``XB`` (unit variance)."""
+    """Matern 5/2 correlation matrix between the rows of ``XA`` and ``XB`` (unit variance); one per
+    row of length scales of shape (k, 1, d)."""
     return matern52_of_distance(scaled_distance(XA, XB, length_scale))

@@ -329,7 +329,7 @@ class SweepSurrogate:
                 else:
                     scales = ", ".join(f"{n} {v:.2g}" for n, v in zip(domain.inputs, gp.length_scale_))
                     about = f"scatter sd {gp.noise_std:.2g}  length scales ({scales})"
-                    if len(getattr(gp, "draws_", ())):
+                    if len(gp.draws_):
                         about += f"  averaged over {len(gp.draws_)} hyperparameter draws"
                 lines.append(f"  {target:<22} n {cv['n']:>3}  CV RMSE {cv['rmse']:.3g}  max {cv['max_abs_error']:.3g}  "
                              f"95% coverage {100 * cv['coverage_95']:.0f} %  Q2 {cv['q2'] if cv['q2'] is None else round(cv['q2'], 3)}  "

@@ -73,7 +73,7 @@ def error_unknown(cv: dict, gp) -> str | None:
 def loo_predictions(gp):
     """Closed-form leave-one-out mean and std (target units) of a fitted :class:`GaussianProcess`
     (of the mixture over its hyperparameter draws where it has them)."""
-    if getattr(gp, "mixture_", None) is not None:
+    if gp.mixture_ is not None:
         mean, var = gp.mixture_.leave_one_out(gp.y_train_)
         return gp.y_mean_ + gp.y_scale_ * mean, gp.y_scale_ * np.sqrt(var)
     d = np.diag(inverse_from_cholesky(gp.L_))
