@@ -122,10 +122,14 @@ class GaussianProcess:
         self.draws_ = np.asarray(draws, dtype=float).reshape(-1, self.X_train_.shape[1] + 2)
         self.mixture_ = Mixture(self.X_train_, self.y_train_, self.draws_) if len(self.draws_) else None
 
+    def noise_bottom(self) -> float:
+        """Lower bound of the noise variance (standardized units): the nominal bound, or the square
+        of the replicate floor ``noise_floor_sd`` where that is higher."""
+        return max(self.noise_bounds[0], (self.noise_floor_sd / self.y_scale_) ** 2)
+
     def _bounds(self, d):
-        low, high = self.noise_bounds
-        floor = (self.noise_floor_sd / self.y_scale_) ** 2  # standardized units
-        noise = (max(low, floor), max(high, floor))
+        bottom = self.noise_bottom()
+        noise = (bottom, max(self.noise_bounds[1], bottom))
         return np.log([self.constant_bounds] + [self.length_scale_bounds] * d + [noise])
 
     def _starts(self, d, n_runs):

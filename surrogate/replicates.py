@@ -11,7 +11,9 @@ pairs, the offset is ``mean(d)`` and the scatter of one run has standard deviati
 Without a floor, maximizing the GP's marginal likelihood on a few dozen runs may explain the
 scatter by short length scales and put the noise at the bottom of its range: intervals 100x too
 narrow (docs/surrogate.md, "Noise floor"). The floor keeps the white-noise variance at least at the
-measured scatter.
+measured scatter. It is a lower bound: a mesh change moves only part of the scatter a GP meets
+across the inputs (0.5-0.75 of it in RSJ runs), so a fit whose noise sits at the floor has not
+estimated it (:func:`colonsim.surrogate.validation.error_unknown`).
 """
 
 from __future__ import annotations

@@ -25,13 +25,14 @@ def rsj(n_runs, seed, noise=NOISE):
     return synthetic_sweep(n_runs=n_runs, segments=("rsj",), noise_cm=noise, n_failed=0, seed=seed)
 
 
-def replicates_of(table, n, seed, noise=NOISE):
+def replicates_of(table, n, seed, noise=NOISE, shared=False):
     """The first ``n`` cases of ``table`` run again (another mesh): the same inputs, new scatter of
-    sd ``noise`` and an offset of 0.02 cm in every run."""
+    sd ``noise`` and an offset of 0.02 cm in every run. ``shared``: the new scatter adds to the
+    originals' own (a mesh change that moves only part of the scatter), so the pairs see only it."""
     again = table.iloc[:n].copy()
     clean = synthetic_outputs("rsj", again["scope_diameter_mm"], again["diameter_mm"], again["angle_deg"],
                               again["friction"])[TARGET]
-    again[TARGET] = clean + 0.02 + np.random.default_rng(seed).normal(0.0, noise, n)
+    again[TARGET] = (again[TARGET] if shared else clean) + 0.02 + np.random.default_rng(seed).normal(0.0, noise, n)
     again["element_size_mm"] = 2.8
     again["key"] = again["key"] + "-fine"  # another run: another key
     return again
@@ -137,22 +138,28 @@ def test_too_few_runs_says_so_instead_of_a_number(train, tmp_path, capsys):
     assert "(no interval: too few runs to know its error (6 < 10))" in out and "+-" not in out.split("\n")[1]
 
 
-def test_noise_at_its_bound_is_not_an_estimate_unless_replicates_measured_it():
+def test_noise_at_its_bound_is_not_an_estimate():
     """Runs without scatter: the fit puts the noise at the bottom of its range, which says nothing
-    about a simulation's scatter; replicate runs that measure it make the error known."""
+    about a simulation's scatter; nor does a noise at the floor replicate runs measured (one source
+    of the scatter only). A noise the fit estimated above that floor makes the error known."""
     clean = rsj(24, seed=11, noise=0.0)
     model = SweepSurrogate(targets=(TARGET,), n_restarts=1).fit(clean)
     assert "bottom of its range" in model.error_unknown("rsj", TARGET)
-    measured = SweepSurrogate(targets=(TARGET,), n_restarts=1,
+    at_floor = SweepSurrogate(targets=(TARGET,), n_restarts=1,
                               replicates=replicates_of(clean, 8, seed=3, noise=0.01)).fit(clean)
+    assert "at the floor the replicate runs measured" in at_floor.error_unknown("rsj", TARGET)
+    noisy = rsj(24, seed=11)  # scatter NOISE = 0.05 cm, of which the replicates see 0.01 cm
+    measured = SweepSurrogate(targets=(TARGET,), n_restarts=1,
+                              replicates=replicates_of(noisy, 8, seed=3, noise=0.01, shared=True)).fit(noisy)
+    assert measured.models_["rsj"][TARGET].noise_std > 2 * measured.scatter_["rsj"][TARGET]["sd"]
     assert measured.error_unknown("rsj", TARGET) is None
 
 
-def test_cross_validated_errors_larger_than_the_sd_make_the_error_unknown(floored):
+def test_cross_validated_errors_larger_than_the_sd_make_the_error_unknown(train):
     from colonsim.surrogate.validation import error_unknown
 
-    gp = floored.models_["rsj"][TARGET]
-    cv = dict(floored.cv_["rsj"][TARGET])
+    model = SweepSurrogate(targets=(TARGET,), n_restarts=1).fit(train)  # the noise estimated
+    gp, cv = model.models_["rsj"][TARGET], dict(model.cv_["rsj"][TARGET])
     assert error_unknown(cv, gp) is None and cv["z_rms"] < 1.3
     assert "1.6 times the sd it states (at most 1.23 with 24 runs)" in error_unknown({**cv, "z_rms": 1.6}, gp)
 
