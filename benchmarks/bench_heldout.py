@@ -151,7 +151,7 @@ def heldout(train_folders, test_folder, replicates_folder, sizes, restarts=None,
                 scatter = fitted.scatter_["rsj"][target]
                 floor = "" if scatter is None else f", floor {scatter['sd']:.3g} from {scatter['pairs']} pairs"
                 print(f"  {name}, {size} runs, {label}{floor}: {noise_of(fitted.models_['rsj'][target])}; "
-                      f"{fitted.error_unknown('rsj', target) or 'error known'}")
+                      f"{s['error_unknown'] or 'error known'}")
                 print_score("", s)
                 if label == ("replicate floor" if replicates is not None else "no floor"):
                     style = {"color": f"C{sizes.index(size)}", "ls": "--" if fitted is one_gp else "-"}

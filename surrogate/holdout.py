@@ -116,7 +116,7 @@ def score(model, table: pd.DataFrame, target, segment=None, name="held-out table
     stated, held = pair_orders(mean, cov, scope)
     holds = held(y)
     return {"segment": domain.segment, "target": target, "n": int(len(y)), "left_out": left_out,
-            "outside_box": outside, "n_train": gp.n_train,
+            "outside_box": outside, "n_train": gp.n_train, "error_unknown": model.error_unknown(domain.segment, target),
             "rmse": float(np.sqrt(np.mean(err**2))), "q2": float(1.0 - np.sum(err**2) / ss) if ss > 0 else None,
             "coverage": {f"{round(100 * p)}": coverage(err, sd, p) for p in NOMINAL},
             "z_mean": float(z.mean()), "z_sd": float(z.std(ddof=1)),
@@ -136,6 +136,9 @@ def format_score(s, unit="") -> str:
              f"  coverage of the 50 / 90 / 95 % intervals: {100 * cov['50']:.0f} / {100 * cov['90']:.0f} / "
              f"{100 * cov['95']:.0f} %",
              f"  standardized error: mean {s['z_mean']:+.2f}, sd {s['z_sd']:.2f} (calibrated: about 0 and 1)"]
+    if s.get("error_unknown"):
+        lines.append(f"  the model itself prints no interval ({s['error_unknown']}): these are the intervals it "
+                     "would state")
     o = s["orders"]
     if o["pairs"]:
         lines.append(f"  predicted orders of {o['pairs']} run pairs with different scopes: hold {100 * o['held']:.0f} %, "

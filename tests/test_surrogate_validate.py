@@ -96,6 +96,19 @@ def test_validate_command(floored, test_table, tmp_path, capsys):
     assert (tmp_path / "reliability.png").stat().st_size > 10_000
     doc = json.loads((tmp_path / "scores.json").read_text())
     assert doc["scores"][0]["target"] == TARGET and len(doc["scores"][0]["reliability"]["observed"]) == 19
+    # its noise sits at the replicate floor: the score says the model itself states no interval
+    assert "at the floor the replicate runs measured" in doc["scores"][0]["error_unknown"]
+    assert "the model itself prints no interval (too few runs" in text
+
+
+def test_validate_command_of_a_model_that_knows_its_error(train, test_table, tmp_path, capsys):
+    from colonsim.surrogate.store import save_surrogate
+
+    save_surrogate(SweepSurrogate(targets=(TARGET,), n_restarts=1).fit(train), tmp_path / "model")
+    test_table.to_parquet(tmp_path / "test.parquet")
+    assert main(["surrogate", "validate", str(tmp_path / "model.json"), str(tmp_path / "test.parquet")]) == 0
+    text = capsys.readouterr().out
+    assert "standardized error: mean" in text and "prints no interval" not in text
 
 
 @pytest.mark.parametrize("drop,message", [("diameter_mm", "lacks the input column(s) diameter_mm"),
