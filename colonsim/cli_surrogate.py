@@ -83,8 +83,9 @@ def add_parsers(sub):
     fit.add_argument("--material", type=Path, help=MATERIAL_HELP.replace("predictions average", "stored with the "
                                                                           "model, that predictions average"))
     fit.add_argument("--replicates", type=Path,
-                     help="results table of training cases run again at another mesh or push speed: their scatter "
-                          "is each output's noise floor (docs/surrogate.md, 'Noise floor')")
+                     help="results table of training cases run again at another wall mesh: their scatter is each "
+                          "output's noise floor (docs/surrogate.md, 'Noise floor'; another push speed hardly "
+                          "moves a settled output, 'Limits')")
     fit.add_argument("--threads", type=worker_count, default=1,
                      help="BLAS threads (default 1; more only pays on an idle machine with thousands of runs)")
     fit.set_defaults(func=cmd_fit)

@@ -59,7 +59,7 @@ class SweepSurrogate:
         The wall-material distribution predictions average over (:mod:`colonsim.surrogate.tissue`);
         default: the one the sweep sampled, read from the runs (``tissue_``).
     replicates : DataFrame or None
-        Results table of training cases run again at another mesh or push speed: per output, the
+        Results table of training cases run again at another wall mesh: per output, the
         scatter of the pairs is the noise floor of its GP (:mod:`colonsim.surrogate.replicates`,
         ``scatter_``). None: no floor.
     hyperparameter_draws : int or None

@@ -1,7 +1,8 @@
 """The simulation's own scatter, measured by replicate runs: the surrogate's noise floor.
 
 A replicate is a training run's case (the same inputs) run again at another solver setting that
-should not matter, such as a slightly different wall mesh or push speed
+should not matter, such as a slightly different wall mesh (another push speed hardly moves a
+settled output such as the final deformation: docs/surrogate.md, "Limits")
 (``benchmarks/sweeps/gp_replicates.toml``: ten RSJ cases on a 2.8 mm instead of 3 mm mesh). The
 two results of a pair differ by the simulation's scatter (contact on a discrete mesh, dynamic
 effects) plus an offset the setting causes in every run alike. With ``d`` the differences of the
