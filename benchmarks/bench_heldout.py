@@ -41,7 +41,7 @@ def heldout_arguments(parser):
     parser.add_argument("--heldout", type=Path, nargs="+", required=True, help="training sweep folders (RSJ, in order)")
     parser.add_argument("--test", type=Path, required=True, help="the held-out sweep folder")
     parser.add_argument("--replicates", type=Path, required=True,
-                        help="training cases run again at another mesh or push speed (the noise floor)")
+                        help="training cases run again at another wall mesh (the noise floor)")
     parser.add_argument("--train-sizes", type=int, nargs="+", default=[12, 20, 40])
 
 

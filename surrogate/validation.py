@@ -64,7 +64,7 @@ def error_unknown(cv: dict, gp) -> str | None:
     if n < MIN_CHECKED_RUNS:
         return f"too few runs to know its error ({n} < {MIN_CHECKED_RUNS})"
     collapsed = [p for p in getattr(gp, "parts", (gp,)) if noise_at_bottom(p)]  # a LargerOf: either part
-    if any(p.noise_floor_sd <= 0 for p in collapsed):
+    if any(p.noise_bottom() <= p.noise_bounds[0] for p in collapsed):  # at the nominal bound, not a floor
         return ("too few runs to know its error: the fit put the run-to-run scatter at the bottom of its range instead "
                 "of estimating it; measure it with replicate runs (fit --replicates)")
     if collapsed:
