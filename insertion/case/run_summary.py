@@ -6,7 +6,7 @@ from __future__ import annotations
 
 from colonsim.catalog import colon_model
 from colonsim.insertion.anatomy.manoeuvre import SETTLE
-from colonsim.insertion.case.outcomes import (JAM_PROGRESS, JAM_PUSH, PEAK_WINDOW, REST_TOLERANCE, REST_WINDOW,
+from colonsim.insertion.case.outcomes import (JAM_FORCE, JAM_PROGRESS, JAM_PUSH, PEAK_WINDOW, REST_TOLERANCE, REST_WINDOW,
                                               RINGING_LIMIT, RINGING_WINDOW, characteristic_points, peak_trend,
                                               quasi_static_fraction, rest_drift, ringing_ratio)
 from colonsim.insertion.engine.material import REFERENCE_MATERIAL_PATH
@@ -18,7 +18,7 @@ ENDINGS = {
     "length_used": "the scope's available length was pushed in",
     "wall_stretch": "the wall's largest stretch passed the failure stretch",
     "jam": f"the tip jammed: under {JAM_PROGRESS * 1e3:g} mm of tip progress over {JAM_PUSH * 100:g} cm of push "
-           "while the push force rose",
+           f"under a push force of {JAM_FORCE:g} N or more",
 }
 
 
