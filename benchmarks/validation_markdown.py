@@ -5,6 +5,7 @@ from __future__ import annotations
 import math
 
 from colonsim.files import atomic_path
+from colonsim.insertion.case.run_summary import ENDINGS
 from colonsim.insertion.study.verification_rules import GROUPS
 from colonsim.markdown import NOT_RUN, md_table, num, percent
 from validation_changes import markdown as changes_markdown
@@ -381,8 +382,8 @@ def run_ends(sections):
     lines = ["## 12. How every run ended", "",
              "`ended_by` (docs/model.md, \"Loading\"): `tip_past_end` (RSJ: the tip 2 cm past the sigmoid's fixed "
              "end), `far_end` (the tip at the far end of the exit), `length_used` (the scope's available length "
-             "pushed in), `jam` (the tip advanced under 1 mm over 2 cm of push while the push force rose). End "
-             "state: pushed depth, push and contact force at the end.", ""]
+             f"pushed in), `wall_stretch` (the wall's largest stretch past the failure stretch), `jam` "
+             f"({ENDINGS['jam']}). End state: pushed depth, push and contact force at the end.", ""]
     for name, s in sections.items():
         sweep = s["sweep"]
         lines += [f"### {name.capitalize()} sweep", ""]
