@@ -382,7 +382,7 @@ def run_ends(sections):
     lines = ["## 12. How every run ended", "",
              "`ended_by` (docs/model.md, \"Loading\"): `tip_past_end` (RSJ: the tip 2 cm past the sigmoid's fixed "
              "end), `far_end` (the tip at the far end of the exit), `length_used` (the scope's available length "
-             f"pushed in), `wall_stretch` (the wall's largest stretch past the failure stretch), `jam` "
+             "pushed in), `wall_stretch` (the wall's largest stretch past the failure stretch), `jam` "
              f"({ENDINGS['jam']}). End state: pushed depth, push and contact force at the end.", ""]
     for name, s in sections.items():
         sweep = s["sweep"]

@@ -254,8 +254,8 @@ def jammed(depth, tip_arc, push_force, window=JAM_PUSH, progress=JAM_PROGRESS, f
         return False
     last = z >= z[-1] - PEAK_WINDOW
     w = depth_weights(z[last])
-    f = np.asarray(push_force, dtype=float)[last]
-    return bool(np.sum(w * f) >= force * np.sum(w) and np.sum(w) > 0.0)
+    pushed = np.sum(w)
+    return bool(pushed > 0.0 and np.sum(w * np.asarray(push_force, dtype=float)[last]) >= force * pushed)
 
 
 REST_WINDOW = 0.05  # s of the closing hold over which a run must be still to have come to rest

@@ -6,9 +6,9 @@ from __future__ import annotations
 
 from colonsim.catalog import colon_model
 from colonsim.insertion.anatomy.manoeuvre import SETTLE
-from colonsim.insertion.case.outcomes import (JAM_FORCE, JAM_PROGRESS, JAM_PUSH, PEAK_WINDOW, REST_TOLERANCE, REST_WINDOW,
-                                              RINGING_LIMIT, RINGING_WINDOW, characteristic_points, peak_trend,
-                                              quasi_static_fraction, rest_drift, ringing_ratio)
+from colonsim.insertion.case.outcomes import (JAM_FORCE, JAM_PROGRESS, JAM_PUSH, PEAK_WINDOW, REST_TOLERANCE,
+                                              REST_WINDOW, RINGING_LIMIT, RINGING_WINDOW, characteristic_points,
+                                              peak_trend, quasi_static_fraction, rest_drift, ringing_ratio)
 from colonsim.insertion.engine.material import REFERENCE_MATERIAL_PATH
 from colonsim.provenance import code_version
 
