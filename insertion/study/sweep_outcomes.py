@@ -6,8 +6,10 @@ when a worker died or a task was lost); :mod:`colonsim.insertion.study.sweep` re
 
 from __future__ import annotations
 
+import contextlib
 import math
 import multiprocessing
+import signal
 import uuid
 from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
 from concurrent.futures.process import BrokenProcessPool
@@ -78,7 +80,8 @@ def local_outcomes(cases, workers=2, runner=None, pool=None):
             while pending or in_flight:
                 while pending and len(in_flight) < workers:
                     case = pending.pop(0)
-                    in_flight[executor.submit(execute, case, runner)] = case
+                    with sigint_held():  # submit may spawn a worker: it starts with Ctrl-C held
+                        in_flight[executor.submit(execute, case, runner)] = case
                 done, _ = wait(in_flight, return_when=FIRST_COMPLETED)
                 broken = False
                 for future in done:
@@ -101,6 +104,26 @@ def local_outcomes(cases, workers=2, runner=None, pool=None):
         finally:
             if own or not clean:  # a shared pool stays open unless the sweep was stopped
                 pool.discard(wait=clean)
+
+
+@contextlib.contextmanager
+def sigint_held():
+    """Hold Ctrl-C (SIGINT) back from this thread for the block; one that arrives meanwhile is
+    delivered when the block ends, none is lost.
+
+    A worker process inherits the held signal: one still importing when Ctrl-C reaches the process
+    group would print a ``KeyboardInterrupt`` traceback; held, the signal waits until
+    :func:`~colonsim.insertion.study.sweep_worker.start_worker` has installed its quiet exit and
+    releases it.
+    """
+    if not hasattr(signal, "pthread_sigmask"):  # Windows: no signal masks (and no process groups)
+        yield
+        return
+    previous = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
+    try:
+        yield
+    finally:
+        signal.pthread_sigmask(signal.SIG_SETMASK, previous)
 
 
 def dask_outcomes(cases, address, runner=None, log=print):

@@ -102,8 +102,12 @@ def start_worker(warm_up=True):
     import signal
 
     # Ctrl-C reaches the whole process group: the parent stops the sweep and says so in one line;
-    # a worker leaves at once and quietly (a KeyboardInterrupt would print its own traceback)
+    # a worker leaves at once and quietly (a KeyboardInterrupt would print its own traceback). The
+    # pool starts workers with SIGINT held (sweep_outcomes.sigint_held): one that came while this
+    # process was importing is delivered now, to the quiet exit.
     signal.signal(signal.SIGINT, lambda signum, frame: os._exit(130))
+    if hasattr(signal, "pthread_sigmask"):
+        signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGINT})
     exit_with_parent()
     try:
         prepare_worker(warm_up)
