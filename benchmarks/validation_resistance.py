@@ -16,10 +16,11 @@ import math
 import numpy as np
 
 from colonsim.insertion.case.insertion_case import InsertionCase
-from colonsim.insertion.case.outcomes import RINGING_LIMIT
+from colonsim.insertion.case.outcomes import RINGING_LIMIT, ringing_wavelength
 from colonsim.insertion.study.claims import evaluate_claims
 from colonsim.markdown import NOT_RUN, md_table, num
 from validation_resistance_readings import claim_readings
+from validation_sections import case_geometry
 from validation_sweeps import role, scope_label
 
 LEVELS_N = (0.0, 5.0, 10.0, 20.0)
@@ -64,7 +65,7 @@ def resistance_section(sweep) -> dict:
     claims = claims_per_level(sweep, speed)
     return {"ran": True, "rows": rows, "missing": missing, "differences": _differences(rows),
             "rsj": [r for r in rows if r["segment"] == "rsj"], "rate": _rate_pairs(sweep, speed),
-            "quasi_static": _quasi_static(rows), "claims": claims,
+            "quasi_static": _quasi_static(rows), "remainder": ringing_remainder(sweep, speed), "claims": claims,
             "claims_largest": claims_per_level(sweep, speed, "max_deformation_cm"),
             "readings": claim_readings(claims, rows), "figures": []}
 
@@ -114,6 +115,39 @@ def _quasi_static(rows) -> dict:
             "largest": max(ratios) if ratios else None, "above": above}
 
 
+def ringing_remainder(sweep, speed) -> dict:
+    """The runs at the default speed that ring above the limit (``above``): the ringing in newtons
+    next to the mean push force it is divided by, the push distance it repeats over
+    (:func:`~colonsim.insertion.case.outcomes.ringing_wavelength`, from the run's time series as
+    its summary measures it: the closing settle left out) and the wall mesh's ring spacing; and the
+    ringing in newtons of the runs below the limit (``rms_below_N``), for scale."""
+    above, rms_below = [], []
+    for case in sweep.cases:
+        row, _ = sweep.run(case) if math.isclose(case.push_speed, speed) else (None, None)
+        ratio = _number(row, "ringing_ratio")
+        if ratio is None:
+            continue
+        qs = sweep.summary(row).get("quasi_static") or {}
+        if ratio < RINGING_LIMIT:
+            if qs.get("push_force_rms_N") is not None:
+                rms_below.append(qs["push_force_rms_N"])
+            continue
+        ts = sweep.timeseries(row, ["phase", "depth_cm", "push_force_N", "contact_nodes"])
+        wavelength = None
+        if ts is not None:
+            ts = ts[ts["phase"] != "settle"]
+            w = ringing_wavelength(ts["depth_cm"].to_numpy() / 100, ts["push_force_N"].to_numpy(),
+                                   ts["contact_nodes"].to_numpy() > 0)
+            wavelength = 1e3 * w if np.isfinite(w) else None
+        geometry = case_geometry(case)
+        rings = len(geometry.nodes) // (int(geometry.end_ring.sum()) // 2)  # two end rings of equal count
+        above.append({"segment": case.segment, "scope": scope_label(case), "where": _where(case),
+                      "level_N": case.distal_resistance_N, "ringing_ratio": ratio, "rms_N": qs.get("push_force_rms_N"),
+                      "mean_N": qs.get("mean_push_force_N"), "wavelength_mm": wavelength,
+                      "ring_spacing_mm": 1e3 * geometry.centerline_length / (rings - 1)})
+    return {"above": above, "rms_below_N": rms_below}
+
+
 def _rate_pairs(sweep, speed) -> list:
     """Each half-speed run against the run with the same inputs at the default speed."""
     by_inputs = {}
@@ -154,6 +188,23 @@ def _verdict_cell(entry):
     return entry["verdict"] + (f": {reason}" if reason else "")
 
 
+def _remainder_lines(remainder) -> list:
+    if not remainder["above"]:
+        return []
+    below = np.asarray(remainder["rms_below_N"], dtype=float)
+    scale = (f"; the {below.size} runs below the limit ring by {num(np.min(below))}-{num(np.max(below))} N (median "
+             f"{num(np.median(below))} N)" if below.size else "")
+    return ["The runs above the limit: the ringing in newtons (RMS about the trend; over the mean push force it is "
+            "the ratio), the push distance it repeats over (the peak of its periodogram, "
+            "`outcomes.ringing_wavelength`) and the wall mesh's ring spacing (docs/model.md, \"Time integration and "
+            f"damping\", what no push speed removes){scale}:", "",
+            md_table(remainder["above"], [("model", lambda r: r["segment"].upper()), ("scope", "scope"),
+                                          ("case", "where"), ("level [N]", lambda r: f"{r['level_N']:g}"),
+                                          ("ringing", "ringing_ratio"), ("RMS [N]", "rms_N"),
+                                          ("mean push [N]", "mean_N"), ("repeats every [mm of push]", "wavelength_mm"),
+                                          ("ring spacing [mm]", "ring_spacing_mm")]), ""]
+
+
 def markdown(section) -> list:
     """The section's Markdown lines."""
     lines = ["## 14. Distal resistance", "",
@@ -166,6 +217,8 @@ def markdown(section) -> list:
     qs = section["quasi_static"]
     lines += [f"Quasi-static: {qs['below']} of {qs['measured']} measured runs ring below {RINGING_LIMIT:g} (largest "
               f"{num(qs['largest'])})" + (": above it " + "; ".join(qs["above"]) if qs["above"] else "") + ".", ""]
+    if section.get("remainder"):
+        lines += _remainder_lines(section["remainder"])
     if section["missing"]:
         lines += [f"Missing runs ({len(section['missing'])}): " + "; ".join(section["missing"]) + ".", ""]
     for segment in ("rsj", "rsf", "thf", "thf-fixed"):

@@ -363,6 +363,8 @@ COLUMNS = {c.name: c for c in (
     Column("push_speed", _S, "m/s", "plateau push speed"),
     Column("held_push_share", _S, "", "share of the push speed once the distal resistance holds the tip "
                                       "(docs/model.md, \"Loading\")"),
+    Column("held_push_lead_mm", _S, "mm", "distance before the fixed exit at which the held push begins (0: when "
+                                        "the resistance engages)"),
     Column("ramp_s", _S, "s", "speed-change ramp"),
     Column("relax_s", _S, "s", "relax pause of straighten-relax-push"),
     Column("stop_distance_mm", _S, "mm", "push over which the scope slows to rest at the end of the run (0: at once)"),

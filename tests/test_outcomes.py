@@ -4,7 +4,8 @@ import numpy as np
 import pytest
 
 from colonsim.insertion.case.outcomes import (JAM_FORCE, JAM_PROGRESS, JAM_PUSH, characteristic_points, jammed,
-                                              principal_stretches, quasi_static_fraction, sliding_kinetic_energy)
+                                              principal_stretches, quasi_static_fraction, ringing_wavelength,
+                                              sliding_kinetic_energy)
 
 
 def rsj_like(noise=0.0, seed=0):
@@ -137,3 +138,35 @@ def test_ringing_force_is_judged_by_its_mean_over_5_mm(mean, jam):
     force = mean + 20.0 * np.cos(2 * np.pi * PUSH / period)
     assert np.any(force > 43.0) and np.any(force < 43.0)
     assert jammed(PUSH, STUCK, force) is jam
+
+
+def _ringing_push(wavelength_m, amplitude_N=0.1, seed=0):
+    """A push force along 30 cm of push: a slow rise, ringing with the given wavelength in push
+    distance, recording noise, and a pause (many samples at one depth) halfway."""
+    rng = np.random.default_rng(seed)
+    z = np.linspace(0.0, 0.3, 6000)
+    z = np.concatenate((z[:3000], np.full(500, z[3000]), z[3000:]))
+    f = 1.0 + 5.0 * z + amplitude_N * np.sin(2.0 * np.pi * z / wavelength_m) + 0.01 * rng.standard_normal(z.size)
+    return z, f, np.ones(z.size, dtype=bool)
+
+
+@pytest.mark.parametrize("wavelength_mm", [2.5, 5.0, 8.0])
+def test_ringing_wavelength_finds_the_period_in_push_distance(wavelength_mm):
+    z, f, contact = _ringing_push(wavelength_mm * 1e-3)
+    # periodogram bins over 30 cm of push are 1/0.3 per m apart: a 5 mm period is resolved to 1.5 %
+    assert ringing_wavelength(z, f, contact) == pytest.approx(wavelength_mm * 1e-3, rel=0.04)
+
+
+def test_ringing_wavelength_sees_through_a_swell_ten_times_larger():
+    z, f, contact = _ringing_push(7e-3, amplitude_N=0.05)
+    f = f + 0.5 * np.sin(2.0 * np.pi * z / 0.1)  # a 10 cm swell is trend, not ringing
+    assert ringing_wavelength(z, f, contact) == pytest.approx(7e-3, rel=0.04)
+
+
+def test_ringing_wavelength_needs_two_windows_of_push_after_contact():
+    z, f, contact = _ringing_push(5e-3)
+    short = z < 0.015
+    assert np.isnan(ringing_wavelength(z[short], f[short], contact[short]))
+    late = z > 0.285  # contact begins 1.5 cm before the end of the push
+    assert np.isnan(ringing_wavelength(z, f, late))
+    assert np.isnan(ringing_wavelength(z, f, np.zeros(z.size, dtype=bool)))

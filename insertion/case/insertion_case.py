@@ -23,7 +23,7 @@ from colonsim.insertion.case.case_material import case_material
 # cases that do not use them stay what they were (existing sweep folders resume).
 LATER_FIELDS = ("centerline", "centerline_smoothing_mm", "material_parameters", "failure_stretch")
 # fields left out of the key at the value that gives the runs of before they existed
-ABSENT_AT = {"distal_resistance_N": 0.0, "held_push_share": 1.0}
+ABSENT_AT = {"distal_resistance_N": 0.0, "held_push_share": 1.0, "held_push_lead_mm": 0.0}
 
 
 @dataclass
@@ -77,6 +77,10 @@ class InsertionCase:
         Once the distal resistance holds the tip, the push goes on at this share of
         ``push_speed`` (0.5; 1: no change; docs/model.md, "Loading"): a loop forming behind a held
         tip needs a slower push to stay quasi-static than the rest of the insertion.
+    held_push_lead_mm : float
+        The held push begins when the tip is this far (along the centerline, mm) before the fixed
+        exit, so the tip meets the resistance already slowed (0: when the resistance engages;
+        docs/model.md, "The push speed at which the tip meets the resistance").
     sheath_reserve_mm : float
         Scope length that stays in the sheath at the end of the push (**assumption** 20).
     ramp_s, relax_s : float
@@ -121,6 +125,7 @@ class InsertionCase:
     scope_spacing_mm: float = 5.0
     push_speed: float = 0.15
     held_push_share: float = 0.5
+    held_push_lead_mm: float = 0.0
     ramp_s: float = 0.4
     relax_s: float = 0.1
     stop_distance_mm: float = 0.0
@@ -158,6 +163,8 @@ class InsertionCase:
              f"push speed in m/s ({InsertionCase.push_speed:g}; 0.6 in the source)"),
             ("held_push_share", self.held_push_share, 0.05, 1.0,
              f"share of the push speed behind a held tip ({InsertionCase.held_push_share:g}; 1: not slowed)"),
+            ("held_push_lead_mm", self.held_push_lead_mm, 0.0, 500.0,
+             f"distance before the fixed exit at which the held push begins, mm ({InsertionCase.held_push_lead_mm:g})"),
             ("colon_damping", self.colon_damping, 0.0, 1e4, "damping in 1/s"),
             ("scope_damping", self.scope_damping, 0.0, 1e4, "damping in 1/s"),
             ("scope_lateral_damping", self.scope_lateral_damping, 0.0, 1e4, "damping in 1/s"),
@@ -222,6 +229,7 @@ class InsertionCase:
                 del inputs[name]
         if "distal_resistance_N" not in inputs:  # nothing holds the tip: the held push never starts
             inputs.pop("held_push_share", None)
+            inputs.pop("held_push_lead_mm", None)
         if self.centerline is not None:
             inputs["centerline"] = "sha256:" + load_centerline_points(self.centerline).digest()
         return hashlib.sha256(json.dumps(inputs, sort_keys=True).encode()).hexdigest()[:12]

@@ -151,6 +151,40 @@ def ringing_ratio(depth, push_force, in_contact, window=RINGING_WINDOW):
     return {"ratio": ratio, "rms_N": rms, "mean_N": mean, "push_cm": total * 100}
 
 
+def ringing_wavelength(depth, push_force, in_contact, window=RINGING_WINDOW, step=2e-4):
+    """The push distance over which the push force's ringing repeats most strongly (m).
+
+    The ringing (:func:`ringing_ratio`: the force about its trend over ``window`` of push, from
+    the first contact) resampled every ``step`` of push, pauses left out, and the peak of its
+    periodogram (Hann-windowed) among periods shorter than ``window``. A remainder tied to the
+    discretisation shows here as a fixed push distance whatever the push speed: the scope passing
+    over the wall's nodes repeats every one or two rings of the wall mesh (docs/model.md, "Time
+    integration and damping").
+
+    Returns NaN when under two windows of push were measured after the first contact.
+    """
+    z = np.asarray(depth, dtype=float)
+    f = np.asarray(push_force, dtype=float)
+    contact = np.asarray(in_contact, dtype=bool)
+    if not contact.any():
+        return float("nan")
+    first = int(np.argmax(contact))
+    z, f = z[first:], f[first:]
+    if z.size < 3 or z[-1] - z[0] < 2.0 * window:
+        return float("nan")
+    trend, _ = depth_trend(z, f, window)
+    advancing = np.concatenate(([True], np.diff(z) > 0.0))  # a pause has one depth: keep its first sample
+    grid = np.arange(z[0], z[-1], step)
+    residual = np.interp(grid, z[advancing], (f - trend)[advancing])
+    residual = (residual - residual.mean()) * np.hanning(grid.size)
+    power = np.abs(np.fft.rfft(residual)) ** 2
+    frequency = np.fft.rfftfreq(grid.size, step)  # cycles per m of push
+    shorter = frequency > 1.0 / window
+    if not shorter.any():
+        return float("nan")
+    return float(1.0 / frequency[shorter][np.argmax(power[shorter])])
+
+
 def quasi_static_fraction(kinetic, internal, ratio=0.1, floor=1e-12):
     """Fraction of recorded samples with kinetic / internal energy below ``ratio``.
 

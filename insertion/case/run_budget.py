@@ -98,8 +98,8 @@ def estimate_run(case) -> RunBudget:
     duration = float(model.push.duration)
     if model.push.settle_start is not None:  # the closing hold at its shortest: most runs come to rest early
         duration -= case.settle_max_s - case.settle_s
-    if model.resistance is not None:  # the push behind a held tip, from the exit on, is slower
-        held = max(model.total_depth - model.geometry.exit_start, 0.0)
+    if model.resistance is not None:  # the push behind a held tip, from the exit (less the lead) on, is slower
+        held = max(model.total_depth - model.geometry.exit_start + case.held_push_lead_mm * 1e-3, 0.0)
         duration += held / case.push_speed * (1.0 / case.held_push_share - 1.0)
     steps = duration / dt
     nodes = sum(len(solver.state[b.name].x) for b in solver.bodies) - len(model.fixed_nodes)

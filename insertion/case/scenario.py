@@ -18,8 +18,9 @@ Modelling choices (stated so they can be cited):
   every chunk of push from the tip's position along the centerline), along the lumen's direction
   at the tip, regularised at :data:`DISTAL_CREEP_SHARE` of the held push's speed; in the models whose exit
   takes the whole available length, the exit is lengthened so the tip cannot reach its far end;
-- once the tip is held, the rest of the push goes on at ``held_push_share`` of the push speed, to
-  the same depth (:meth:`PushProfile.slow`, the ``held push`` phase; docs/model.md, "Loading");
+- once the tip is held (or, with ``held_push_lead_mm``, that far before the exit), the rest of the
+  push goes on at ``held_push_share`` of the push speed, to the same depth
+  (:meth:`PushProfile.slow`, the ``held push`` phase; docs/model.md, "Loading");
 - quasi-static runs use mass-proportional damping, by default 60 1/s on the colon (about
   critical for its lowest bending modes of ~10 Hz) and 5 1/s on the scope (its rigid push
   through the sheath would otherwise feel a drag of alpha m v);
@@ -297,7 +298,8 @@ def run_insertion(case: InsertionCase, progress=None, snapshot_interval=None) ->
             held = share > 0.0
             reached_exit = reached_exit or held
             model.resistance.engage(share, lumen_direction(model.geometry, last["tip_arc_m"]) if held else None)
-            if held and not settling and ended_by is None:
+            approaching = last["tip_arc_m"] >= model.geometry.exit_start - case.held_push_lead_mm * 1e-3
+            if (held or approaching) and not settling and ended_by is None:
                 push.slow(model.solver.time, case.held_push_share)  # once, in the last push (docs/model.md, "Loading")
         if ended_by is not None:
             if at_rest and model.solver.time >= push.hold_start + case.settle_s - 1e-12 and came_to_rest(recorder.rows):
