@@ -125,6 +125,19 @@ def test_a_resistance_outside_its_range_is_refused_in_one_line(value):
         InsertionCase(distal_resistance_N=value).validate()
 
 
+@pytest.mark.parametrize("value", [-1.0, 501.0, math.nan])
+def test_a_held_push_lead_outside_its_range_is_refused_in_one_line(value):
+    with pytest.raises(ColonsimError, match=r"held_push_lead_mm .* outside \[0, 500\]; give the distance before"):
+        InsertionCase(held_push_lead_mm=value).validate()
+
+
+def test_a_held_push_lead_enters_the_key_only_where_a_resistance_holds_the_tip():
+    assert InsertionCase(held_push_lead_mm=0.0).key() == InsertionCase().key()
+    assert InsertionCase(held_push_lead_mm=50.0).key() != InsertionCase().key()
+    free = InsertionCase(distal_resistance_N=0.0)
+    assert InsertionCase(distal_resistance_N=0.0, held_push_lead_mm=50.0).key() == free.key()
+
+
 def test_the_results_table_and_the_surrogate_know_the_resistance():
     assert catalog.COLUMNS["distal_resistance_N"].surrogate == catalog.SURROGATE_INPUT
     assert catalog.COLUMNS["distal_resistance_N"].option == "--distal-resistance"
