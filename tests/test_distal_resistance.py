@@ -9,7 +9,7 @@ import pytest
 from colonsim import catalog
 from colonsim.errors import ColonsimError
 from colonsim.insertion.case.scenario import (EXIT_MARGIN, InsertionCase, begin_settling, build_insertion,
-                                              resistance_share)
+                                              resistance_share, run_insertion)
 from colonsim.insertion.engine.constraints import LineConstraint, PrescribedVelocity
 from colonsim.insertion.engine.rod import Rod
 from colonsim.insertion.engine.solver import ExplicitSolver
@@ -136,6 +136,24 @@ def test_a_held_push_lead_enters_the_key_only_where_a_resistance_holds_the_tip()
     assert InsertionCase(held_push_lead_mm=50.0).key() != InsertionCase().key()
     free = InsertionCase(distal_resistance_N=0.0)
     assert InsertionCase(distal_resistance_N=0.0, held_push_lead_mm=50.0).key() == free.key()
+
+
+def test_with_a_lead_the_push_slows_before_the_exit_and_the_tip_meets_it_at_the_held_speed():
+    # RSJ on a 6 mm mesh with the 13.3 mm scope: under 20 s; 60 mm is more than the ramp's 4.5 cm
+    # of push, so the held push's speed is reached before the tip enters the exit
+    lead_mm = 60.0
+    run = run_insertion(InsertionCase(segment="rsj", scope="sdc", element_size_mm=6.0, held_push_lead_mm=lead_mm))
+    ts, model = run.timeseries, run.model
+    case, push, exit_start = model.case, model.push, model.geometry.exit_start
+    # the held push starts at the first chunk (1 mm of push) after the tip came within the lead ...
+    first = ts[ts["phase"] == "held push"].iloc[0]
+    assert exit_start - lead_mm * 1e-3 <= first["tip_arc_m"] < exit_start - lead_mm * 1e-3 + 2e-3
+    # ... the resistance still waits for the exit ...
+    entered = ts.loc[ts["tip_arc_m"] > exit_start, "time_s"].iloc[0]
+    assert abs(ts.loc[ts["time_s"] < entered, "distal_force_N"]).max() == 0.0
+    assert abs(ts["distal_force_N"]).max() > 0.5 * case.distal_resistance_N
+    # ... and the tip enters it at the held push's speed
+    assert push.speed(entered) == pytest.approx(case.held_push_share * case.push_speed, rel=1e-9)
 
 
 def test_the_results_table_and_the_surrogate_know_the_resistance():

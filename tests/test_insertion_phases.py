@@ -11,18 +11,10 @@ import pytest
 from colonsim.insertion.case.scenario import InsertionCase, run_insertion
 
 
-RSF_CASE = dict(segment="rsf", scope="utc", angle_deg=30.0, element_size_mm=6.0)
-LEAD_MM = 60.0  # longer than the ramp's 4.5 cm of push: the tip meets the exit at the held speed
-
-
 @pytest.fixture(scope="module")
 def rsf_run():
-    return run_insertion(InsertionCase(**RSF_CASE), snapshot_interval=0.01)
-
-
-@pytest.fixture(scope="module")
-def rsf_run_lead():
-    return run_insertion(InsertionCase(**RSF_CASE, held_push_lead_mm=LEAD_MM))
+    return run_insertion(InsertionCase(segment="rsf", scope="utc", angle_deg=30.0, element_size_mm=6.0),
+                         snapshot_interval=0.01)
 
 
 def test_phases_follow_the_mobile_part(rsf_run):
@@ -76,20 +68,3 @@ def test_the_push_slows_once_the_tip_is_held_and_ends_at_the_same_depth(rsf_run)
     speed = np.diff(steady["depth_m"]) / np.diff(steady["time_s"])
     assert len(speed) > 100 and np.allclose(speed, case.held_push_share * case.push_speed, rtol=1e-6)
     assert ts["depth_m"].iloc[-1] == pytest.approx(model.total_depth, abs=1e-9)  # to the depth of before
-
-
-def test_with_a_lead_the_push_slows_before_the_exit_and_the_tip_meets_it_at_the_held_speed(rsf_run_lead):
-    ts, model = rsf_run_lead.timeseries, rsf_run_lead.model
-    case, push, exit_start = model.case, model.push, model.geometry.exit_start
-    lead = LEAD_MM * 1e-3
-    # the held push starts at the first chunk (1 mm of push) after the tip came within the lead ...
-    first = ts[ts["phase"] == "held push"].iloc[0]
-    assert exit_start - lead <= first["tip_arc_m"] < exit_start - lead + 2e-3
-    # ... the resistance still waits for the exit ...
-    outside = ts[ts["time_s"] < ts.loc[ts["tip_arc_m"] > exit_start, "time_s"].iloc[0]]
-    assert abs(outside["distal_force_N"]).max() == 0.0
-    # ... and the tip enters it at the held push's speed, which goes on to the same depth
-    entered = ts.loc[ts["tip_arc_m"] > exit_start, "time_s"].iloc[0]
-    assert push.speed(entered) == pytest.approx(case.held_push_share * case.push_speed, rel=1e-9)
-    assert ts["depth_m"].iloc[-1] == pytest.approx(model.total_depth, abs=1e-9)
-    assert rsf_run_lead.summary["ended_by"] in ("far_end", "length_used")
