@@ -107,6 +107,13 @@ def peak_trend(depth, values, window=PEAK_WINDOW):
     return float(trend[full].max()) if full.any() else float("nan")
 
 
+def _from_first_contact(depth, push_force, in_contact):
+    """Depth and push force from the first sample in contact on (empty arrays without contact)."""
+    contact = np.asarray(in_contact, dtype=bool)
+    first = int(np.argmax(contact)) if contact.any() else contact.size
+    return np.asarray(depth, dtype=float)[first:], np.asarray(push_force, dtype=float)[first:]
+
+
 def ringing_ratio(depth, push_force, in_contact, window=RINGING_WINDOW):
     """How much the push force rings about its trend, once contact has begun (docs/model.md,
     "Time integration and damping").
@@ -132,14 +139,8 @@ def ringing_ratio(depth, push_force, in_contact, window=RINGING_WINDOW):
     first contact is shorter than the window or its mean force is not positive), ``rms_N``,
     ``mean_N`` and ``push_cm`` (the push distance measured).
     """
-    z = np.asarray(depth, dtype=float)
-    f = np.asarray(push_force, dtype=float)
-    contact = np.asarray(in_contact, dtype=bool)
+    z, f = _from_first_contact(depth, push_force, in_contact)
     empty = {"ratio": float("nan"), "rms_N": float("nan"), "mean_N": float("nan"), "push_cm": 0.0}
-    if not contact.any():
-        return empty
-    first = int(np.argmax(contact))
-    z, f = z[first:], f[first:]
     if z.size < 3 or z[-1] - z[0] < window:
         return {**empty, "push_cm": float((z[-1] - z[0]) * 100) if z.size else 0.0}
     w = depth_weights(z)
@@ -163,13 +164,7 @@ def ringing_wavelength(depth, push_force, in_contact, window=RINGING_WINDOW, ste
 
     Returns NaN when under two windows of push were measured after the first contact.
     """
-    z = np.asarray(depth, dtype=float)
-    f = np.asarray(push_force, dtype=float)
-    contact = np.asarray(in_contact, dtype=bool)
-    if not contact.any():
-        return float("nan")
-    first = int(np.argmax(contact))
-    z, f = z[first:], f[first:]
+    z, f = _from_first_contact(depth, push_force, in_contact)
     if z.size < 3 or z[-1] - z[0] < 2.0 * window:
         return float("nan")
     trend, _ = depth_trend(z, f, window)

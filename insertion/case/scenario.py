@@ -298,8 +298,9 @@ def run_insertion(case: InsertionCase, progress=None, snapshot_interval=None) ->
             held = share > 0.0
             reached_exit = reached_exit or held
             model.resistance.engage(share, lumen_direction(model.geometry, last["tip_arc_m"]) if held else None)
-            approaching = last["tip_arc_m"] >= model.geometry.exit_start - case.held_push_lead_mm * 1e-3
-            if (held or approaching) and not settling and ended_by is None:
+            # held, or within the lead before the exit (at lead 0 this is ``held``: share > 0)
+            slowing = last["tip_arc_m"] > model.geometry.exit_start - case.held_push_lead_mm * 1e-3
+            if slowing and not settling and ended_by is None:
                 push.slow(model.solver.time, case.held_push_share)  # once, in the last push (docs/model.md, "Loading")
         if ended_by is not None:
             if at_rest and model.solver.time >= push.hold_start + case.settle_s - 1e-12 and came_to_rest(recorder.rows):
