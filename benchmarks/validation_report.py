@@ -97,9 +97,10 @@ def flexure_models(main, out):
     return {"rows": sections.public(rows), "figures": figs}
 
 
-def resistance_section(sweep, out):
-    """The distal resistance section, with the final shapes at one level per RSF/THF angle."""
-    section = resistance.resistance_section(sweep)
+def resistance_section(sweep, half, out):
+    """The distal resistance section, with the final shapes at one level per RSF/THF angle; ``half``:
+    its runs above the ringing limit at half the push speed (the proposed bound)."""
+    section = resistance.resistance_section(sweep, half)
     if section["ran"]:
         speed = InsertionCase().push_speed
         for segment in ("rsf", "thf"):
@@ -187,7 +188,9 @@ def main(argv=None):
                        ("gp-train", "the surrogate's training sweep (benchmarks/sweeps/gp_train.toml)"),
                        ("gp-test", "the surrogate's held-out sweep (benchmarks/sweeps/gp_test.toml)"),
                        ("rate-angles", "the rate check at the other angles (benchmarks/sweeps/rate_angles.toml)"),
-                       ("resistance", "the distal resistance sweep (colonsim sweep --preset resistance)")):
+                       ("resistance", "the distal resistance sweep (colonsim sweep --preset resistance)"),
+                       ("ringing-half", "the resistance runs above the ringing limit at half the push speed "
+                                        "(benchmarks/sweeps/ringing_half_speed.toml)")):
         parser.add_argument(f"--{name}-sweep", type=Path, default=None,
                             help=f"folder of {what}; its section says NOT RUN without it")
     parser.add_argument("--previous", type=Path, default=None,
@@ -202,9 +205,11 @@ def main(argv=None):
     try:
         main_sweep = read_sweep("main", args.sweep)
         validation = read_sweep("validation", args.validation_sweep, preset="validation")
-        smooth, gp_train, gp_test, resisted, angles = (read_sweep(label, folder, optional=True) for label, folder in (
-            ("smoothness", args.smoothness_sweep), ("gp_train", args.gp_train_sweep), ("gp_test", args.gp_test_sweep),
-            ("resistance", args.resistance_sweep), ("rate_angles", args.rate_angles_sweep)))
+        smooth, gp_train, gp_test, resisted, angles, ringing_half = (
+            read_sweep(label, folder, optional=True) for label, folder in (
+                ("smoothness", args.smoothness_sweep), ("gp_train", args.gp_train_sweep),
+                ("gp_test", args.gp_test_sweep), ("resistance", args.resistance_sweep),
+                ("rate_angles", args.rate_angles_sweep), ("ringing_half", args.ringing_half_sweep)))
         previous = None if args.previous is None else read_previous(args.previous)
     except ColonsimError as exc:
         print(f"error: {exc}", file=sys.stderr)
@@ -246,7 +251,7 @@ def main(argv=None):
                           "figure": "figures/smoothness.png",
                           "surrogate": smoothness.surrogate_holdout(gp_train, gp_test)},
            "flexure_sensitivity": sensitivity,
-           "resistance": resistance_section(resisted, out),
+           "resistance": resistance_section(resisted, ringing_half, out),
            "node_counts": sections.node_counts(),
            "run_ends": {"main": sections.run_ends(main_sweep), "validation": sections.run_ends(validation)},
            "run_times": {"rows": times, "summary": sections.run_time_summary(times)}, "figures": figs}

@@ -215,21 +215,28 @@ def pair_rows(validation, main, check):
                "variant_value": getattr(variant, changed), "base_status": bstatus, "variant_status": vstatus,
                "quantities": [], "passed": None}
         if vrow is not None and brow is not None:
-            judged = []
-            for column, name, floor, tolerance in PAIR_QUANTITIES:
-                if name in ("A", "C") and variant.segment != "rsj":
-                    continue  # the characteristic points are the RSJ's reading of its curve
-                b, v = _number(brow, column), _number(vrow, column)
-                change = relative_change(b, v, floor)
-                ok = None if not np.isfinite(change) else bool(abs(change) < tolerance)
-                out["quantities"].append({"quantity": name, "base": b, "variant": v, "change": change,
-                                          "tolerance": tolerance, "passed": ok})
-                judged += [ok] if ok is not None else []
+            out["quantities"], out["passed"] = pair_quantities(brow, vrow, variant.segment)
             out["ended_by"] = [brow["ended_by"], vrow["ended_by"]]
             out["ringing_ratio"] = [_number(brow, "ringing_ratio"), _number(vrow, "ringing_ratio")]
-            out["passed"] = all(judged) if judged else None
         rows.append(out)
     return rows
+
+
+def pair_quantities(brow, vrow, segment):
+    """(quantities, passed) of a pair of runs of ``segment``: each of :data:`PAIR_QUANTITIES` (A and
+    C only in the RSJ) with its base and variant value, relative change and verdict (None where
+    both lie below its floor), and whether every judged one passes (None: none judged)."""
+    quantities, judged = [], []
+    for column, name, floor, tolerance in PAIR_QUANTITIES:
+        if name in ("A", "C") and segment != "rsj":
+            continue  # the characteristic points are the RSJ's reading of its curve
+        b, v = _number(brow, column), _number(vrow, column)
+        change = relative_change(b, v, floor)
+        ok = None if not np.isfinite(change) else bool(abs(change) < tolerance)
+        quantities.append({"quantity": name, "column": column, "base": b, "variant": v, "change": change,
+                           "tolerance": tolerance, "passed": ok})
+        judged += [ok] if ok is not None else []
+    return quantities, (all(judged) if judged else None)
 
 
 def flexure_sensitivity(validation, main):

@@ -1,0 +1,63 @@
+"""The proposed ringing bound of the validation report (benchmarks/validation_resistance.py): a run
+above the ringing limit counts as quasi-static when half the push speed lowers its ratio by less
+than 20 % and its rate pair passes. Each way it can come out, on made-up table rows."""
+
+import dataclasses
+import sys
+from pathlib import Path
+
+import pandas as pd
+import pytest
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "benchmarks"))
+
+import validation_resistance as resistance  # noqa: E402
+from colonsim.insertion.case.insertion_case import InsertionCase  # noqa: E402
+from colonsim.insertion.study.sweep_presets import HALF_SPEED  # noqa: E402
+
+CASE = InsertionCase(segment="thf", scope="9.2", angle_deg=30.0, distal_resistance_N=0.0)
+BASE = {"ringing_ratio": 0.30, "final_deformation_cm": 1.10, "max_deformation_cm": 1.20,
+        "peak_contact_force_N": 3.0, "peak_push_force_N": 1.1, "point_A_cm": None, "point_C_cm": None}
+
+
+class HalfSweep:
+    """The one run a half-speed sweep holds, under the key of ``CASE`` at half the push speed."""
+
+    def __init__(self, **changed):
+        self.row = pd.Series({**BASE, **changed})
+        self.key = dataclasses.replace(CASE, push_speed=HALF_SPEED).key()
+
+    def run(self, case):
+        return (self.row, "ok") if case.key() == self.key else (None, "not run")
+
+
+def bound(**changed):
+    return resistance.ringing_bound(pd.Series(BASE), HalfSweep(**changed), CASE)
+
+
+def test_a_ringing_half_the_speed_leaves_and_a_passing_rate_pair_hold_the_bound():
+    found = bound(ringing_ratio=0.33, max_deformation_cm=1.22)
+    assert found["bound"] is True
+    assert found["half_ratio"] == pytest.approx(0.33)
+    assert found["ratio_change"] == pytest.approx(0.10)
+    assert resistance._rate_cell(found) == "passes"
+    assert bound(ringing_ratio=0.45)["bound"] is True  # grows at half the speed: not inertia either
+    assert bound(ringing_ratio=0.25)["bound"] is True  # -17 %
+
+
+def test_a_ringing_that_falls_with_the_speed_is_inertia_and_fails_it():
+    found = bound(ringing_ratio=0.23)  # -23 %
+    assert found["rate"]["passed"] is True
+    assert found["bound"] is False
+
+
+def test_a_rate_pair_that_fails_fails_it_and_is_named():
+    found = bound(ringing_ratio=0.30, max_deformation_cm=1.30)  # +8.3 % against the 5 % limit
+    assert found["bound"] is False
+    assert resistance._rate_cell(found) == "NO: max_deformation +8.3 %"
+
+
+def test_without_the_half_speed_run_there_is_no_verdict():
+    assert resistance.ringing_bound(pd.Series(BASE), None, CASE)["bound"] is None
+    other = dataclasses.replace(CASE, angle_deg=45.0)
+    assert resistance.ringing_bound(pd.Series(BASE), HalfSweep(), other)["bound"] is None
