@@ -168,7 +168,7 @@ def ringing_bound(row, half, case) -> dict:
     the sweep ``half``: the ratio there (``half_ratio``), its relative change, the rate pair's
     changes (:func:`rate_changes`) and ``bound`` (True: quasi-static by the bound; None: the
     half-speed run is missing)."""
-    variant = None if half is None else half.run(dataclasses.replace(case, push_speed=HALF_SPEED))[0]
+    variant = None if half is None else half.run(half_speed_twin(case))[0]
     if variant is None:
         return {"half_ratio": None, "ratio_change": None, "rate": None, "bound": None}
     ratio, half_ratio = _number(row, "ringing_ratio"), _number(variant, "ringing_ratio")
@@ -188,22 +188,24 @@ def rate_changes(base, variant, segment) -> dict:
             "passed": passed}
 
 
+def half_speed_twin(case):
+    """``case`` at the rate check's half push speed, every other input the same."""
+    return dataclasses.replace(case, push_speed=HALF_SPEED)
+
+
 def _rate_pairs(sweep, speed) -> list:
-    """Each half-speed run against the run with the same inputs at the default speed."""
-    by_inputs = {}
-    for case in sweep.cases:
-        key = (case.segment, str(case.scope), case.diameter_mm, case.angle_deg, case.distal_resistance_N)
-        by_inputs.setdefault(key, {})[case.push_speed] = case
+    """Each run at the default speed whose half-speed twin the sweep defines, against that twin."""
+    defined = {c.key() for c in sweep.cases}
     out = []
-    for key, cases in by_inputs.items():
-        slow = [s for s in cases if s < speed * 0.99]
-        if speed not in cases or not slow:
+    for case in sweep.cases:
+        twin = half_speed_twin(case)
+        if not math.isclose(case.push_speed, speed) or twin.key() not in defined:
             continue
-        base, variant = (sweep.run(cases[s])[0] for s in (speed, slow[0]))
-        row = {"segment": key[0], "scope": scope_label(cases[speed]), "where": _where(cases[speed]), "level_N": key[4],
-               "changes": {}, "passed": None}
+        base, variant = sweep.run(case)[0], sweep.run(twin)[0]
+        row = {"segment": case.segment, "scope": scope_label(case), "where": _where(case),
+               "level_N": case.distal_resistance_N, "changes": {}, "passed": None}
         if base is not None and variant is not None:
-            row.update(rate_changes(base, variant, key[0]))
+            row.update(rate_changes(base, variant, case.segment))
         out.append(row)
     return out
 
@@ -232,12 +234,12 @@ def _remainder_lines(remainder) -> list:
                ("level [N]", lambda r: f"{r['level_N']:g}"), ("ringing", "ringing_ratio"), ("RMS [N]", "rms_N"),
                ("mean push [N]", "mean_N"), ("repeats every [mm of push]", "wavelength_mm"),
                ("ring spacing [mm]", "ring_spacing_mm")]
-    lines = ["The runs above the limit: the ringing in newtons (RMS about the trend; over the mean push force it is "
+    intro = ("The runs above the limit: the ringing in newtons (RMS about the trend; over the mean push force it is "
              "the ratio), the push distance it repeats over (the peak of its periodogram, "
              "`outcomes.ringing_wavelength`) and the wall mesh's ring spacing (docs/model.md, \"Time integration and "
-             f"damping\", what no push speed removes){scale}"]
+             f"damping\", what no push speed removes){scale}")
     if not remainder.get("half_ran"):
-        return [lines[0] + ":", "", md_table(remainder["above"], columns), "",
+        return [intro + ":", "", md_table(remainder["above"], columns), "",
                 f"The proposed bound: {NOT_RUN}: no --ringing-half-sweep (`colonsim sweep "
                 "benchmarks/sweeps/ringing_half_speed.toml --out DIR`).", ""]
     judged = [r for r in remainder["above"] if r["bound"] is not None]
@@ -246,7 +248,7 @@ def _remainder_lines(remainder) -> list:
                  f"{num(r['half_ratio'])} ({100 * r['ratio_change']:+.0f} %)"),
                 ("rate pair", _rate_cell),
                 ("bound", lambda r: {True: "holds", False: "NO", None: "-"}[r["bound"]])]
-    return [lines[0] + "; and the proposed bound (docs/model.md, \"Ringing that no push speed removes\"): the same "
+    return [intro + "; and the proposed bound (docs/model.md, \"Ringing that no push speed removes\"): the same "
             f"run at half the push speed rings at least {100 * (1 - BOUND_RATIO_FALL):.0f} % as much (inertia's ringing "
             "would fall), and its rate pair passes (5 % on the deformations, 10 % on the peak forces; the failing "
             "columns are named):", "", md_table(remainder["above"], columns), "",
