@@ -366,7 +366,8 @@ COLUMNS = {c.name: c for c in (
     Column("held_push_lead_mm", _S, "mm", "distance before the fixed exit at which the held push begins (0: when "
                                         "the resistance engages)"),
     Column("ramp_s", _S, "s", "speed-change ramp"),
-    Column("relax_s", _S, "s", "relax pause of straighten-relax-push"),
+    Column("relax_s", _S, "s", "relax pause of straighten-relax-push (the constraint fades over it)"),
+    Column("relax_max_s", _S, "s", "longest relax: it goes on until the released system is at rest (0: relax_s)"),
     Column("stop_distance_mm", _S, "mm", "push over which the scope slows to rest at the end of the run (0: at once)"),
     Column("settle_s", _S, "s", "shortest time the scope is held still at the end before the final values are read"),
     Column("settle_max_s", _S, "s", "longest hold at the end: the final values are read once the run has come to rest "

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from colonsim.errors import ColonsimError
-from colonsim.insertion.anatomy.manoeuvre import HELD_PUSH, SETTLE, continuous_push, straighten_relax_push
+from colonsim.insertion.anatomy.manoeuvre import HELD_PUSH, RELAX, SETTLE, continuous_push, straighten_relax_push
 
 
 def test_continuous_push_reaches_the_depth_smoothly():
@@ -99,3 +99,30 @@ def test_no_slow_down_outside_the_last_push_or_without_a_share(when, share):
     t = {"before": p.phases[0].start + 0.5, "push": p.phases[3].start + 0.8, "settle": p.phases[-1].start + 0.1}[when]
     phases = list(p.phases)
     assert not p.slow(t, share) and p.phases == phases and p.slowed_at is None
+
+
+@pytest.mark.parametrize("longer", [0.35, -0.05])
+def test_a_relax_retimed_moves_every_later_phase_and_keeps_depths_and_speeds(longer):
+    p = straighten_relax_push(0.15, 0.40, speed=0.6, ramp=0.05, relax=0.1, settle=0.2)
+    before = [(ph.name, ph.start, ph.end) for ph in p.phases]
+    relax = p.phases[2]
+    assert p.retime(RELAX, relax.end + longer)
+    for (name, start, end), ph in zip(before, p.phases):
+        shift = 0.0 if name in ("straighten", "stop") else longer
+        assert ph.name == name and ph.end == pytest.approx(end + shift, abs=1e-12)
+        assert ph.start == pytest.approx(start + (0.0 if name == "relax" else shift), abs=1e-12)
+    # the push after the relax is the same push, later: the same speed and depth at the same time into it
+    q = straighten_relax_push(0.15, 0.40, speed=0.6, ramp=0.05, relax=0.1, settle=0.2)
+    for tau in (0.0, 0.01, 0.03, 0.2, 0.4):
+        t = q.phases[3].start + tau
+        assert p.depth(t + longer) == pytest.approx(q.depth(t), rel=1e-12, abs=1e-15)
+        assert p.speed(t + longer) == pytest.approx(q.speed(t), rel=1e-12, abs=1e-15)
+    assert p.depth(p.duration) == pytest.approx(0.40, rel=1e-12)
+    assert p.speed(relax.start + 0.5 * (relax.end - relax.start)) == 0.0
+
+
+def test_only_a_pause_is_retimed():
+    p = straighten_relax_push(0.15, 0.40, speed=0.6, ramp=0.05, relax=0.1)
+    assert not p.retime("push", p.duration + 1.0)  # a moving phase
+    assert not p.retime(RELAX, p.phases[2].start - 0.01)  # before its own start
+    assert not continuous_push(0.2).retime(RELAX, 1.0)  # no relax

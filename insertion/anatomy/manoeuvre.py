@@ -22,7 +22,7 @@ the scope is never jerked (a step in speed launches an axial wave of amplitude r
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -160,6 +160,19 @@ class PushProfile:
         self.__post_init__()
         return True
 
+    def retime(self, name, end) -> bool:
+        """Let the pause ``name`` (a phase at rest: the ``relax``) end at ``end`` (s), later or
+        sooner than planned; every later phase moves by as much, at the same depths and speeds.
+        Returns whether the profile changed (not for a phase that moves)."""
+        k = next((i for i, p in enumerate(self.phases) if p.name == name), None)
+        if k is None or self.phases[k].speed != 0.0 or self._starts[k][1] != 0.0 or end < self.phases[k].start:
+            return False
+        shift = end - self.phases[k].end
+        self.phases = (self.phases[:k] + [replace(self.phases[k], end=end)]
+                       + [replace(p, start=p.start + shift, end=p.end + shift) for p in self.phases[k + 1:]])
+        self.__post_init__()
+        return True
+
     @property
     def lateral_constraint_end(self):
         """End of the last phase that holds the mobile part laterally, s (None: no such phase)."""
@@ -175,6 +188,7 @@ class PushProfile:
 
 SETTLE = "settle"
 HELD_PUSH = "held push"
+RELAX = "relax"
 
 
 def _settle(phases, speed, stop_distance, settle):
@@ -227,7 +241,7 @@ def straighten_relax_push(straighten_depth, depth, speed=0.6, ramp=0.05, relax=0
     t4 = t3 + _time_to_push(depth - straighten_depth, speed, ramp)
     phases = [Phase("straighten", 0.0, t1, speed, lateral_constraint=True),
               Phase("stop", t1, t2, 0.0, lateral_constraint=True),
-              Phase("relax", t2, t3, 0.0),
+              Phase(RELAX, t2, t3, 0.0),
               Phase("push", t3, t4, speed)]
     return PushProfile(_settle(phases, speed, stop_distance, settle), ramp)
 

@@ -23,7 +23,7 @@ from colonsim.insertion.case.case_material import case_material
 # cases that do not use them stay what they were (existing sweep folders resume).
 LATER_FIELDS = ("centerline", "centerline_smoothing_mm", "material_parameters", "failure_stretch")
 # fields left out of the key at the value that gives the runs of before they existed
-ABSENT_AT = {"distal_resistance_N": 0.0, "held_push_share": 1.0, "held_push_lead_mm": 0.0}
+ABSENT_AT = {"distal_resistance_N": 0.0, "held_push_share": 1.0, "held_push_lead_mm": 0.0, "relax_max_s": 0.0}
 
 
 @dataclass
@@ -84,7 +84,13 @@ class InsertionCase:
     sheath_reserve_mm : float
         Scope length that stays in the sheath at the end of the push (**assumption** 20).
     ramp_s, relax_s : float
-        Speed-change ramp and the relax pause of RSF/THF, s.
+        Speed-change ramp and the relax pause of RSF/THF, s (the straightening constraint fades
+        over ``relax_s``).
+    relax_max_s : float
+        RSF/THF: with a value > 0 the relax goes on after ``relax_s`` until the released system
+        has come to rest (the criterion of the closing hold), at most ``relax_max_s`` in all; the
+        final push then starts from an equilibrium (docs/model.md, "Loading"). 0: the relax
+        lasts ``relax_s`` (the runs of before).
     stop_distance_mm, settle_s, settle_max_s : float
         The push ends at rest: it slows to a stop over ``stop_distance_mm`` of push (default 0:
         at once), every node is then stopped where it is (its kinetic energy removed) and the scope
@@ -128,6 +134,7 @@ class InsertionCase:
     held_push_lead_mm: float = 0.0
     ramp_s: float = 0.4
     relax_s: float = 0.1
+    relax_max_s: float = 0.0
     stop_distance_mm: float = 0.0
     settle_s: float = 0.1
     settle_max_s: float = 1.0
@@ -178,12 +185,17 @@ class InsertionCase:
             ("time_step_factor", self.time_step_factor, 0.01, 1.0, "a safety factor in (0, 1]"),
             ("ramp_s", self.ramp_s, 0.0, 10.0, "ramp duration in s (0.4)"),
             ("relax_s", self.relax_s, 1e-3, 10.0, "relax duration in s (0.1 by default)"),
+            ("relax_max_s", self.relax_max_s, 0.0, 10.0,
+             "longest relax until at rest, s (0: the relax lasts relax_s)"),
             ("failure_stretch", self.failure_stretch, 1.01, 10.0, "wall stretch at which a run ends (1.6)"),
             ("sheath_reserve_mm", self.sheath_reserve_mm, 0.0, 200.0, "scope length kept in the sheath, mm (20)"),
         ]
         for name, value, lo, hi, what in checks:
             if not (isinstance(value, (int, float)) and math.isfinite(value) and lo <= value <= hi):
                 raise ColonsimError(f"{name} = {value!r} is outside [{lo:g}, {hi:g}]; give the {what}")
+        if 0.0 < self.relax_max_s < self.relax_s:
+            raise ColonsimError(f"relax_max_s = {self.relax_max_s:g} s is shorter than relax_s = {self.relax_s:g} s; "
+                                "give at least relax_s, or 0 for a relax of relax_s")
         if self.element_size_mm > self.diameter_mm / 3:
             raise ColonsimError(f"element size {self.element_size_mm} mm is too coarse for a {self.diameter_mm} mm colon; "
                                 "use at most a third of the diameter")

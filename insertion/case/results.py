@@ -60,6 +60,18 @@ def rest_words(rest: dict) -> str:
             "settled (raise settle_max_s)")
 
 
+def relax_words(relax: dict | None) -> str:
+    """Whether the relax of RSF/THF came to rest before the final push (a summary's ``relax``;
+    None: no relax held until at rest), for the command line."""
+    if relax is None:
+        return ""
+    if relax["came_to_rest"]:
+        return f"relaxed to rest {relax['held_s']:.2f} s after the release; "
+    drift = relax["deformation_drift_mm"]
+    moved = "" if drift is None else f" (the deformation still moved {drift:.3f} mm over {REST_WINDOW:g} s)"
+    return f"the relax did NOT come to rest in {relax['held_s']:.2f} s{moved}: the push went on from motion (raise relax_max_s); "
+
+
 def distal_words(summary: dict) -> str:
     """The distal resistance and the scope's lag of a summary, for the command line."""
     d = summary["distal_resistance"]

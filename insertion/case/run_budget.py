@@ -10,7 +10,8 @@ the wall time; :func:`check_run_budget` refuses a run over a step limit, naming 
 The estimate is of the start: contact later shortens the step a little (RSJ, D 36 mm, 13.3 mm
 scope: 35,961 steps estimated, 41,326 taken), a run may end before the push does (the tip passed
 the end), and the closing hold is counted at its shortest (``settle_s``; a run that takes long to
-come to rest holds up to ``settle_max_s``). The push behind a held tip (``held_push_share``) is
+come to rest holds up to ``settle_max_s``), and so is the relax of RSF/THF (``relax_s``; held until
+at rest it can last up to ``relax_max_s``). The push behind a held tip (``held_push_share``) is
 counted from the pushed depth at which the tip would reach the exit along the centerline, without
 its speed ramp.
 """

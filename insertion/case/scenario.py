@@ -48,7 +48,7 @@ from colonsim.catalog import CONTINUOUS_PUSH, colon_model
 from colonsim.errors import ColonsimError
 from colonsim.insertion.anatomy.centerline import TubeClash
 from colonsim.insertion.anatomy.colon_segments import EXIT_LIMIT, colon_geometry
-from colonsim.insertion.anatomy.manoeuvre import SETTLE, PushProfile, continuous_push, straighten_relax_push
+from colonsim.insertion.anatomy.manoeuvre import RELAX, SETTLE, PushProfile, continuous_push, straighten_relax_push
 from colonsim.insertion.anatomy.scopes import colonoscope
 from colonsim.insertion.case.case_material import case_material
 from colonsim.insertion.case.insertion_case import InsertionCase
@@ -236,15 +236,22 @@ def bring_to_rest(model):
         state.v[:] = 0.0
 
 
-def came_to_rest(rows) -> bool:
-    """Have the recorded samples ``rows`` (the recorder's dicts) been still over the last
-    :data:`~colonsim.insertion.case.outcomes.REST_WINDOW`? (the criterion of :func:`rest_drift`)"""
+def recent_drift(rows):
+    """How far the colon deformation and the tip moved over the last
+    :data:`~colonsim.insertion.case.outcomes.REST_WINDOW` of the recorded samples ``rows`` (the
+    recorder's dicts), m (:func:`rest_drift`; None: the samples span less)."""
     k = len(rows) - 1
     while k > 0 and rows[k]["time_s"] > rows[-1]["time_s"] - REST_WINDOW:
         k -= 1  # back to the first sample at or before the window's start
     tail = rows[k:]
-    drift = rest_drift([r["time_s"] for r in tail], [r["deformation_m"] for r in tail],
-                       [r["tip_displacement_m"] for r in tail])
+    return rest_drift([r["time_s"] for r in tail], [r["deformation_m"] for r in tail],
+                      [r["tip_displacement_m"] for r in tail])
+
+
+def came_to_rest(rows) -> bool:
+    """Have the recorded samples ``rows`` been still over the last
+    :data:`~colonsim.insertion.case.outcomes.REST_WINDOW`? (the criterion of :func:`rest_drift`)"""
+    drift = recent_drift(rows)
     return drift is not None and max(drift) < REST_TOLERANCE
 
 
@@ -275,7 +282,27 @@ def run_insertion(case: InsertionCase, progress=None, snapshot_interval=None) ->
     settling = at_rest = False
     reached_exit = False  # the resistance has engaged: from then on the tip is held back, never jammed
     chunks = 0
+    relax = next((p for p in push.phases if p.name == RELAX), None)
+    relaxing = relax is not None and case.relax_max_s > 0.0  # the relax goes on until at rest
+    relax_begun = False
+    relax_outcome = None
     while model.solver.time < push.duration - 1e-9:
+        if relaxing and model.solver.time >= relax.start - 1e-12:
+            if not relax_begun:  # planned at its longest, cut once at rest
+                relax_begun = True
+                push.retime(RELAX, relax.start + case.relax_max_s)
+                last_push = [p for p in push.phases if p.name != SETTLE][-1]
+            if model.solver.time >= relax.start + case.relax_s - 1e-12:  # the constraint has faded
+                drift = recent_drift(recorder.rows)
+                rested = drift is not None and max(drift) < REST_TOLERANCE
+                if rested or model.solver.time >= relax.start + case.relax_max_s - 1e-12:
+                    relaxing = False
+                    end = min(model.solver.time, relax.start + case.relax_max_s)
+                    relax_outcome = {"came_to_rest": rested, "held_s": end - relax.start,
+                                     "deformation_drift_mm": None if drift is None else drift[0] * 1e3,
+                                     "tip_drift_mm": None if drift is None else drift[1] * 1e3}
+                    push.retime(RELAX, end)
+                    last_push = [p for p in push.phases if p.name != SETTLE][-1]
         if not settling and push.settle_start is not None and model.solver.time >= push.settle_start:
             settling = True
             begin_settling(model)
@@ -283,6 +310,8 @@ def run_insertion(case: InsertionCase, progress=None, snapshot_interval=None) ->
             at_rest = True
             bring_to_rest(model)
         step = min(chunk_s, push.duration - model.solver.time)
+        if relaxing and relax_begun:  # the relax's bound is a chunk's end
+            step = min(step, max(relax.start + case.relax_max_s - model.solver.time, 1e-9))
         model.solver.run(step, record_interval=case.record_interval_s, callbacks=[recorder], exact_end=False)
         if not recorder.rows or recorder.rows[-1]["time_s"] < model.solver.time:
             recorder(model.solver)  # the state at the end of every chunk is a sample
@@ -326,5 +355,9 @@ def run_insertion(case: InsertionCase, progress=None, snapshot_interval=None) ->
     summary = summarize(model, frame, wall, t0 - t_build)
     summary["ended_by"] = ended_by
     summary["end"] = end_state(model, frame, ended_by)
+    if relax_outcome is not None:
+        summary["relax"] = {"criterion": f"once the straightening constraint has faded, the colon deformation and the tip "
+                                         f"each move less than {REST_TOLERANCE * 1e3:g} mm over {REST_WINDOW:g} s, "
+                                         "or relax_max_s has passed", **relax_outcome}
     final = {"colon_m": model.solver.state["colon"].x.copy(), "scope_m": model.solver.state[model.rod.name].x.copy()}
     return InsertionResult(case, frame, summary, recorder.snapshots, model, final)
