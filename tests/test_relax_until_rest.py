@@ -54,9 +54,13 @@ def test_a_relax_cut_short_says_it_did_not_come_to_rest(relaxed):
     assert max(relax["deformation_drift_mm"], relax["tip_drift_mm"]) > REST_TOLERANCE * 1e3
 
 
-def test_without_relax_max_s_the_relax_lasts_relax_s_and_the_key_is_unchanged():
+def test_the_relax_bound_enters_the_key_only_where_there_is_a_relax():
     assert InsertionCase(relax_max_s=0.0).key() == InsertionCase().key()
-    assert InsertionCase(relax_max_s=1.0).key() != InsertionCase().key()
+    thf = InsertionCase(segment="thf", angle_deg=45.0)
+    assert InsertionCase(segment="thf", angle_deg=45.0, relax_max_s=1.0).key() != thf.key()
+    # a model without a relax (RSJ, fixed THF) keeps its key whatever the bound
+    assert InsertionCase(relax_max_s=1.0).key() == InsertionCase().key()
+    assert InsertionCase(segment="thf-fixed", relax_max_s=1.0).key() == InsertionCase(segment="thf-fixed").key()
 
 
 @pytest.mark.parametrize("value", [0.05, -1.0, 11.0])

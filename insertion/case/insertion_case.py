@@ -11,7 +11,7 @@ import json
 import math
 from dataclasses import asdict, dataclass
 
-from colonsim.catalog import colon_model
+from colonsim.catalog import COLON_MODELS, colon_model
 from colonsim.input_ranges import check_input_range
 from colonsim.errors import ColonsimError
 from colonsim.insertion.anatomy.centerline_file import load_centerline_points
@@ -239,6 +239,9 @@ class InsertionCase:
         for name, value in ABSENT_AT.items():
             if inputs[name] == value:
                 del inputs[name]
+        model = COLON_MODELS.get(self.segment)
+        if model is not None and not model.straightens:  # no relax: its bound does nothing
+            inputs.pop("relax_max_s", None)
         if "distal_resistance_N" not in inputs:  # nothing holds the tip: the held push never starts
             inputs.pop("held_push_share", None)
             inputs.pop("held_push_lead_mm", None)
