@@ -102,6 +102,11 @@ class PushProfile:
         last = self.phases[-1]
         return last.start if last.name == SETTLE else None
 
+    @property
+    def last_push(self):
+        """The last phase before the closing ``settle`` (it moves later if a pause is retimed)."""
+        return [p for p in self.phases if p.name != SETTLE][-1]
+
     def ramp_of(self, phase):
         """The speed ramp into ``phase``, s (the profile's own unless the phase sets one)."""
         return self.ramp if phase.ramp is None else phase.ramp
@@ -129,8 +134,7 @@ class PushProfile:
         (the ``held push`` phase, its speed reached over the profile's ramp; a push that ends
         sooner ends still slowing). A closing ``settle`` phase keeps its stop distance and hold.
         Only once and only during the last push; returns whether the profile changed."""
-        moving = [p for p in self.phases if p.name != SETTLE]
-        last = moving[-1]
+        last = self.last_push
         if (self.slowed_at is not None or not 0.0 < share < 1.0 or not last.start <= t < last.end
                 or last.speed <= 0.0):
             return False

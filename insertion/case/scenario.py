@@ -48,7 +48,7 @@ from colonsim.catalog import CONTINUOUS_PUSH, colon_model
 from colonsim.errors import ColonsimError
 from colonsim.insertion.anatomy.centerline import TubeClash
 from colonsim.insertion.anatomy.colon_segments import EXIT_LIMIT, colon_geometry
-from colonsim.insertion.anatomy.manoeuvre import RELAX, SETTLE, PushProfile, continuous_push, straighten_relax_push
+from colonsim.insertion.anatomy.manoeuvre import RELAX, PushProfile, continuous_push, straighten_relax_push
 from colonsim.insertion.anatomy.scopes import colonoscope
 from colonsim.insertion.case.case_material import case_material
 from colonsim.insertion.case.insertion_case import InsertionCase
@@ -276,7 +276,6 @@ def run_insertion(case: InsertionCase, progress=None, snapshot_interval=None) ->
     recorder = InsertionRecorder(model, snapshot_interval)
     t0 = time.perf_counter()
     push = model.push
-    last_push = [p for p in push.phases if p.name != SETTLE][-1]
     chunk_s = min(0.01, CHUNK_PUSH / case.push_speed)
     ended_by = None
     settling = at_rest = False
@@ -291,7 +290,6 @@ def run_insertion(case: InsertionCase, progress=None, snapshot_interval=None) ->
             if not relax_begun:  # planned at its longest, cut once at rest
                 relax_begun = True
                 push.retime(RELAX, relax.start + case.relax_max_s)
-                last_push = [p for p in push.phases if p.name != SETTLE][-1]
             if model.solver.time >= relax.start + case.relax_s - 1e-12:  # the constraint has faded
                 drift = recent_drift(recorder.rows)
                 rested = drift is not None and max(drift) < REST_TOLERANCE
@@ -302,7 +300,6 @@ def run_insertion(case: InsertionCase, progress=None, snapshot_interval=None) ->
                                      "deformation_drift_mm": None if drift is None else drift[0] * 1e3,
                                      "tip_drift_mm": None if drift is None else drift[1] * 1e3}
                     push.retime(RELAX, end)
-                    last_push = [p for p in push.phases if p.name != SETTLE][-1]
         if not settling and push.settle_start is not None and model.solver.time >= push.settle_start:
             settling = True
             begin_settling(model)
@@ -339,7 +336,7 @@ def run_insertion(case: InsertionCase, progress=None, snapshot_interval=None) ->
             ended_by = "wall_stretch"
         elif push.settle_start is not None and model.solver.time >= push.settle_start:
             ended_by = "length_used"
-        elif model.solver.time >= last_push.start and tip_passed_end(last, model):
+        elif model.solver.time >= push.last_push.start and tip_passed_end(last, model):
             ended_by = "tip_past_end" if model.geometry.end_depth < model.geometry.centerline_length else "far_end"
         elif not reached_exit and recorder.jammed():
             ended_by = "jam"
