@@ -246,6 +246,7 @@ def main(argv=None):
            "rate_check": {**pair_section(validation, main_sweep, "rate"),
                           "speeds": (InsertionCase().push_speed, HALF_SPEED),
                           "held_share": InsertionCase().held_push_share,
+                          "held_lead_mm": InsertionCase().held_push_lead_mm,
                           "angles": pair_section(angles, main_sweep, "rate")},
            "smoothness": {"cubic": smoothness.cubic_departures(smooth, out / "figures" / "smoothness.png"),
                           "figure": "figures/smoothness.png",

@@ -86,7 +86,8 @@ def test_the_settling_run_holds_the_tip_without_creep():
 
 
 def test_zero_resistance_builds_no_resistance_and_keeps_the_key_of_before():
-    case = InsertionCase(segment="rsf", angle_deg=45.0, element_size_mm=COARSE_MM, distal_resistance_N=0.0)
+    case = InsertionCase(segment="rsf", angle_deg=45.0, element_size_mm=COARSE_MM, distal_resistance_N=0.0,
+                         relax_max_s=0.0)  # the relax of before: relax_s alone
     assert build_insertion(case).resistance is None
     inputs = case.to_dict()
     for name in ("distal_resistance_N", "failure_stretch", "held_push_share", "held_push_lead_mm", "relax_max_s"):
@@ -132,10 +133,22 @@ def test_a_held_push_lead_outside_its_range_is_refused_in_one_line(value):
 
 
 def test_a_held_push_lead_enters_the_key_only_where_a_resistance_holds_the_tip():
-    assert InsertionCase(held_push_lead_mm=0.0).key() == InsertionCase().key()
-    assert InsertionCase(held_push_lead_mm=50.0).key() != InsertionCase().key()
+    import hashlib
+    import json
+
+    # 50 mm by default (2026-11-28); at 0, the runs of before, it stays out of the key
+    assert InsertionCase(held_push_lead_mm=50.0).key() == InsertionCase().key()
+    before = InsertionCase(held_push_lead_mm=0.0)
+    assert before.key() != InsertionCase().key()
+    inputs = before.to_dict()
+    for name in ("held_push_lead_mm", "relax_max_s",  # no relax in the RSJ
+                 "centerline", "centerline_smoothing_mm", "material_parameters", "failure_stretch"):
+        del inputs[name]
+    assert before.key() == hashlib.sha256(json.dumps(inputs, sort_keys=True).encode()).hexdigest()[:12]
+    # nothing holds the tip: the lead does nothing and stays out
     free = InsertionCase(distal_resistance_N=0.0)
-    assert InsertionCase(distal_resistance_N=0.0, held_push_lead_mm=50.0).key() == free.key()
+    assert InsertionCase(distal_resistance_N=0.0, held_push_lead_mm=0.0).key() == free.key()
+    assert InsertionCase(distal_resistance_N=0.0, held_push_lead_mm=120.0).key() == free.key()
 
 
 def test_with_a_lead_the_push_slows_before_the_exit_and_the_tip_meets_it_at_the_held_speed():

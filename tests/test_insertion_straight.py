@@ -5,7 +5,7 @@ import json
 import pytest
 
 from colonsim.cli import main
-from colonsim.insertion.case.scenario import InsertionCase, run_insertion
+from colonsim.insertion.case.scenario import InsertionCase, chunk_seconds, run_insertion
 
 
 @pytest.fixture(scope="module")
@@ -25,11 +25,13 @@ def test_the_push_reaches_the_far_end_and_rests(straight_run):
     ts = straight_run.timeseries
     case = straight_run.case
     # the run ends once the tip crosses the far end ring's plane (x = 20 cm), checked every mm of
-    # push; the scope then slows to rest over the stop distance and settles
+    # push; the scope then slows to rest over the stop distance and settles: held at least
+    # settle_s, ended at the first check of the end rules (a chunk's end) once at rest
     assert straight_run.summary["ended_by"] == "far_end"
     settle = ts[ts["phase"] == "settle"]
-    assert settle["time_s"].iloc[-1] - settle["time_s"].iloc[0] == pytest.approx(
-        2 * case.stop_distance_mm * 1e-3 / case.push_speed + case.settle_s, abs=2e-3)
+    held = settle["time_s"].iloc[-1] - settle["time_s"].iloc[0]
+    shortest = 2 * case.stop_distance_mm * 1e-3 / case.push_speed + case.settle_s
+    assert shortest - 2e-3 <= held <= shortest + chunk_seconds(case) + 2e-3
     crossing = ts["depth_m"][ts["tip_past_end_m"] >= 0.0].iloc[0]
     assert ts["depth_m"].iloc[-1] - crossing == pytest.approx(case.stop_distance_mm * 1e-3, abs=1.1e-3)
     # brought to rest where the push stopped and held: nothing moves at the end

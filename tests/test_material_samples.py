@@ -118,9 +118,10 @@ def test_every_case_is_crossed_with_every_draw(tmp_path):
     # are other runs, with the end at rest (stopped at once, brought to rest, stop_distance_mm 0), and
     # with the hold until the run has come to rest (settle_max_s, settle_lateral_damping 20 1/s), and
     # with the held push (held_push_share 0.5 behind a tip the distal resistance holds), and with the
-    # 0.15 m/s push
-    assert InsertionCase().key() == "017707d53ff5"
-    assert InsertionCase(segment="rsf", scope="utc", angle_deg=30, friction=0.05).key() == "3577433662e4"
+    # 0.15 m/s push, and with the defaults of 2026-11-28 (the held push 50 mm before the exit, the
+    # relax until at rest, the shortest closing hold 0.5 s)
+    assert InsertionCase().key() == "d1aafd84d442"
+    assert InsertionCase(segment="rsf", scope="utc", angle_deg=30, friction=0.05).key() == "cbf520e7eee8"
 
 
 def test_population_uses_each_specimen_once_or_a_seeded_subset(tmp_path):

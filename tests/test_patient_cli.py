@@ -89,8 +89,8 @@ def test_a_patient_runs_from_the_command_line(files, capsys):
 
 
 def test_case_checks_and_keys(files):
-    assert InsertionCase().key() == "017707d53ff5"  # the quasi-static defaults (0.15 m/s), the 5 N distal resistance, the held push and the end at rest; see test_material_samples
-    assert InsertionCase(segment="rsf", scope="utc", angle_deg=30, friction=0.05).key() == "3577433662e4"
+    assert InsertionCase().key() == "d1aafd84d442"  # the quasi-static defaults (0.15 m/s), the 5 N distal resistance, the held push and the end at rest, the defaults of 2026-11-28; see test_material_samples
+    assert InsertionCase(segment="rsf", scope="utc", angle_deg=30, friction=0.05).key() == "cbf520e7eee8"
     with pytest.raises(ColonsimError, match="use segment 'patient'"):
         InsertionCase(segment="rsj", centerline=str(files / "good.csv")).validate()
     case = InsertionCase(segment="patient", centerline=str(files / "good.csv"), scope="utc")

@@ -79,8 +79,9 @@ class InsertionCase:
         tip needs a slower push to stay quasi-static than the rest of the insertion.
     held_push_lead_mm : float
         The held push begins when the tip is this far (along the centerline, mm) before the fixed
-        exit, so the tip meets the resistance already slowed (0: when the resistance engages;
-        docs/model.md, "The push speed at which the tip meets the resistance").
+        exit, so the tip meets the resistance already slowed (50; 0: when the resistance engages;
+        docs/model.md, "The push speed at which the tip meets the resistance" and "The defaults of
+        2026-11-28").
     sheath_reserve_mm : float
         Scope length that stays in the sheath at the end of the push (**assumption** 20).
     ramp_s, relax_s : float
@@ -89,12 +90,12 @@ class InsertionCase:
     relax_max_s : float
         RSF/THF: with a value > 0 the relax goes on after ``relax_s`` until the released system
         has come to rest (the criterion of the closing hold), at most ``relax_max_s`` in all; the
-        final push then starts from an equilibrium (docs/model.md, "Loading"). 0: the relax
-        lasts ``relax_s`` (the runs of before).
+        final push then starts from an equilibrium (5; docs/model.md, "Loading"). 0: the relax
+        lasts ``relax_s`` (the runs of before 2026-11-28).
     stop_distance_mm, settle_s, settle_max_s : float
         The push ends at rest: it slows to a stop over ``stop_distance_mm`` of push (default 0:
         at once), every node is then stopped where it is (its kinetic energy removed) and the scope
-        is held still for at least ``settle_s`` and until it has come to rest (the criterion of
+        is held still for at least ``settle_s`` (0.5) and until it has come to rest (the criterion of
         :func:`colonsim.insertion.case.outcomes.rest_drift`), at most ``settle_max_s``; the final
         values are read then, and the summary says whether it came to rest (docs/model.md, "Loading").
     settle_lateral_damping : float
@@ -131,12 +132,12 @@ class InsertionCase:
     scope_spacing_mm: float = 5.0
     push_speed: float = 0.15
     held_push_share: float = 0.5
-    held_push_lead_mm: float = 0.0
+    held_push_lead_mm: float = 50.0
     ramp_s: float = 0.4
     relax_s: float = 0.1
-    relax_max_s: float = 0.0
+    relax_max_s: float = 5.0
     stop_distance_mm: float = 0.0
-    settle_s: float = 0.1
+    settle_s: float = 0.5
     settle_max_s: float = 1.0
     settle_lateral_damping: float = 20.0
     exit_length_mm: float = 100.0
@@ -177,7 +178,7 @@ class InsertionCase:
             ("scope_lateral_damping", self.scope_lateral_damping, 0.0, 1e4, "damping in 1/s"),
             ("scope_axial_damping_s", self.scope_axial_damping_s, 0.0, 0.1, "Kelvin-Voigt damping time in s (3e-3)"),
             ("stop_distance_mm", self.stop_distance_mm, 0.0, 100.0, "push distance to slow to rest, mm (0)"),
-            ("settle_s", self.settle_s, 0.0, 10.0, "shortest hold at rest at the end, s (0.1)"),
+            ("settle_s", self.settle_s, 0.0, 10.0, f"shortest hold at rest at the end, s ({InsertionCase.settle_s:g})"),
             ("settle_max_s", self.settle_max_s, self.settle_s, 10.0,
              "longest hold at rest at the end, s, at least settle_s (1.0)"),
             ("settle_lateral_damping", self.settle_lateral_damping, 0.0, 1e4, "damping in 1/s"),
@@ -186,7 +187,7 @@ class InsertionCase:
             ("ramp_s", self.ramp_s, 0.0, 10.0, "ramp duration in s (0.4)"),
             ("relax_s", self.relax_s, 1e-3, 10.0, "relax duration in s (0.1 by default)"),
             ("relax_max_s", self.relax_max_s, 0.0, 10.0,
-             "longest relax until at rest, s (0: the relax lasts relax_s)"),
+             f"longest relax until at rest, s ({InsertionCase.relax_max_s:g}; 0: the relax lasts relax_s)"),
             ("failure_stretch", self.failure_stretch, 1.01, 10.0, "wall stretch at which a run ends (1.6)"),
             ("sheath_reserve_mm", self.sheath_reserve_mm, 0.0, 200.0, "scope length kept in the sheath, mm (20)"),
         ]

@@ -259,6 +259,11 @@ CHUNK_PUSH = 1e-3  # m: the end rules are checked after every millimetre of push
 GUARD_CHUNKS = 5  # chunks between two checks that the scope is still inside the colon (lumen_guard)
 
 
+def chunk_seconds(case: InsertionCase) -> float:
+    """Simulated time between two checks of the end rules: :data:`CHUNK_PUSH` of push, at most 10 ms."""
+    return min(0.01, CHUNK_PUSH / case.push_speed)
+
+
 def run_insertion(case: InsertionCase, progress=None, snapshot_interval=None) -> InsertionResult:
     """Build and run one insertion.
 
@@ -276,7 +281,7 @@ def run_insertion(case: InsertionCase, progress=None, snapshot_interval=None) ->
     recorder = InsertionRecorder(model, snapshot_interval)
     t0 = time.perf_counter()
     push = model.push
-    chunk_s = min(0.01, CHUNK_PUSH / case.push_speed)
+    chunk_s = chunk_seconds(case)
     ended_by = None
     settling = at_rest = False
     reached_exit = False  # the resistance has engaged: from then on the tip is held back, never jammed
