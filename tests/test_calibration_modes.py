@@ -3,6 +3,7 @@ stress-stretch reader, joint fits on Treloar's data, the Drucker check, and the 
 calibration left as it was."""
 
 import json
+import re
 import time
 
 import numpy as np
@@ -182,7 +183,10 @@ def test_a_material_file_is_written_when_mu0_is_not_identified(tmp_path, capsys)
     doc = json.loads((tmp_path / "og" / "material.json").read_text())
     assert doc["uncertainty"]["unidentified"] and doc["small_strain"]["mu0_sd_Pa"] is None
     assert doc["small_strain"]["mu0_Pa"] == pytest.approx(84658.7, rel=1e-4)
-    assert "mu0 = 84658.7 Pa, sd inf (not identified" in capsys.readouterr().out
+    # printed as found: the optimizer's path, and so the last digits, differ between machines
+    # (84658.7 Pa in 24,228 evaluations on one, 84658.9 Pa in 24,286 on another)
+    printed = re.search(r"mu0 = ([0-9.]+) Pa, sd inf \(not identified", capsys.readouterr().out)
+    assert printed and float(printed.group(1)) == pytest.approx(doc["small_strain"]["mu0_Pa"], abs=0.05)
 
 
 # The bundled colon calibration (mean curve, closed form, quick budget, seed 1) before the
