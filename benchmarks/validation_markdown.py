@@ -238,10 +238,10 @@ def mesh_pair(section):
 def rate_check(section):
     base, half = section.get("speeds") or ("?", "?")
     share, lead = section.get("held_share"), section.get("held_lead_mm")
-    begins = ("once the distal resistance holds the tip," if not lead else
-              f"from {lead:g} mm before the fixed exit, where the distal resistance will hold the tip,")
+    begins = ("Once the distal resistance holds the tip," if not lead else
+              f"From {lead:g} mm before the fixed exit, where the distal resistance will hold the tip,")
     held = ("" if share is None or share == 1.0 else
-            f" {begins[0].upper() + begins[1:]} both push at {share:g} of these speeds (docs/model.md, "
+            f" {begins} both push at {share:g} of these speeds (docs/model.md, "
             "\"Loading\").")
     lines = _pair_section(8, f"Rate check: {base} against {half} m/s",
                          "Every scope of one case per colon model pushed at half the speed (docs/model.md, \"Time "

@@ -1,6 +1,8 @@
 """The distal resistance (docs/model.md, "Loading"): its regularised law in closed form, nothing
 changed at 0 N, where it acts in each colon model, and its place in keys, tables and queries."""
 
+import hashlib
+import json
 import math
 
 import numpy as np
@@ -85,19 +87,22 @@ def test_the_settling_run_holds_the_tip_without_creep():
     assert model.resistance.creep_speed == 0.0 and model.rod.lateral_damping == 150.0
 
 
+def key_without(case, *names):
+    """The key of ``case`` computed by hand with ``names`` left out of its inputs."""
+    inputs = case.to_dict()
+    for name in names:
+        del inputs[name]
+    return hashlib.sha256(json.dumps(inputs, sort_keys=True).encode()).hexdigest()[:12]
+
+
 def test_zero_resistance_builds_no_resistance_and_keeps_the_key_of_before():
     case = InsertionCase(segment="rsf", angle_deg=45.0, element_size_mm=COARSE_MM, distal_resistance_N=0.0,
                          relax_max_s=0.0)  # the relax of before: relax_s alone
     assert build_insertion(case).resistance is None
-    inputs = case.to_dict()
-    for name in ("distal_resistance_N", "failure_stretch", "held_push_share", "held_push_lead_mm", "relax_max_s"):
-        del inputs[name]  # the runs of before lacked them
-    for name in ("centerline", "centerline_smoothing_mm", "material_parameters"):
-        del inputs[name]
-    import hashlib
-    import json
-
-    assert case.key() == hashlib.sha256(json.dumps(inputs, sort_keys=True).encode()).hexdigest()[:12]
+    # the runs of before lacked the first five; the last three stay out at their defaults
+    assert case.key() == key_without(case, "distal_resistance_N", "failure_stretch", "held_push_share",
+                                     "held_push_lead_mm", "relax_max_s",
+                                     "centerline", "centerline_smoothing_mm", "material_parameters")
     assert InsertionCase(distal_resistance_N=5.0).key() != InsertionCase(distal_resistance_N=0.0).key()
 
 
@@ -133,18 +138,13 @@ def test_a_held_push_lead_outside_its_range_is_refused_in_one_line(value):
 
 
 def test_a_held_push_lead_enters_the_key_only_where_a_resistance_holds_the_tip():
-    import hashlib
-    import json
-
     # 50 mm by default (2026-11-28); at 0, the runs of before, it stays out of the key
     assert InsertionCase(held_push_lead_mm=50.0).key() == InsertionCase().key()
     before = InsertionCase(held_push_lead_mm=0.0)
     assert before.key() != InsertionCase().key()
-    inputs = before.to_dict()
-    for name in ("held_push_lead_mm", "relax_max_s",  # no relax in the RSJ
-                 "centerline", "centerline_smoothing_mm", "material_parameters", "failure_stretch"):
-        del inputs[name]
-    assert before.key() == hashlib.sha256(json.dumps(inputs, sort_keys=True).encode()).hexdigest()[:12]
+    assert before.key() == key_without(before, "held_push_lead_mm", "relax_max_s",  # no relax in the RSJ
+                                       "centerline", "centerline_smoothing_mm", "material_parameters",
+                                       "failure_stretch")
     # nothing holds the tip: the lead does nothing and stays out
     free = InsertionCase(distal_resistance_N=0.0)
     assert InsertionCase(distal_resistance_N=0.0, held_push_lead_mm=0.0).key() == free.key()
