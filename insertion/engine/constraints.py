@@ -47,6 +47,23 @@ def line_constraint_kernel(x, v_new, reaction, mass, nodes, point, direction, s_
 
 
 @numba.njit(cache=True)
+def nodes_on_line(x, nodes, point, direction, s_min, s_max):
+    """The listed nodes whose coordinate along the line lies within [s_min, s_max] (computed as
+    :func:`line_constraint_kernel` computes it)."""
+    inside = np.empty(nodes.shape[0], dtype=np.int64)
+    n = 0
+    for j in range(nodes.shape[0]):
+        i = nodes[j]
+        s = 0.0
+        for k in range(3):
+            s += (x[i, k] - point[k]) * direction[k]
+        if s_min <= s <= s_max:
+            inside[n] = i
+            n += 1
+    return inside[:n]
+
+
+@numba.njit(cache=True)
 def _row_sum(values, rows):
     """Sum of ``values[rows]`` (k, 3) without gathering them first."""
     total = np.zeros(3)
@@ -165,7 +182,9 @@ class PrescribedVelocity(Constraint):
         return r.sum(axis=0)
 
     def velocity_rows(self, t_mid, state):
-        return self.nodes, HELD, np.tile(self.velocity(t_mid), (len(self.nodes), 1))
+        targets = np.empty((len(self.nodes), 3))
+        targets[:] = self.velocity(t_mid)
+        return self.nodes, HELD, targets
 
 
 class LineConstraint(Constraint):
@@ -205,6 +224,8 @@ class LineConstraint(Constraint):
         self.direction = d / np.linalg.norm(d)
         self.point = np.asarray(point, dtype=np.float64).reshape(3)
         self.extent = (float(extent[0]), float(extent[1]))
+        self._directions = np.tile(self.direction, (len(self.nodes), 1))  # one row per node it may guide
+        self._directions.setflags(write=False)
 
     def hold(self, t):
         """Fraction of the velocity across the line removed at time ``t`` (1 while held)."""
@@ -220,9 +241,8 @@ class LineConstraint(Constraint):
         if self.hold(t_mid) < 1.0:
             raise ColonsimError("a line constraint let go gradually acts on explicit bodies only (a wall); give the "
                                 "implicitly damped body's constraint no release")
-        s = (state.x[self.nodes] - self.point) @ self.direction
-        nodes = self.nodes[(s >= self.extent[0]) & (s <= self.extent[1])]
-        return nodes, ON_LINE, np.tile(self.direction, (len(nodes), 1))
+        nodes = nodes_on_line(state.x, self.nodes, self.point, self.direction, self.extent[0], self.extent[1])
+        return nodes, ON_LINE, self._directions[:len(nodes)]
 
 
 class NodalLoad(_Window):

@@ -330,7 +330,7 @@ class Shell:
             x, tri, dm_inv, area0, self.thickness, self._law, self._law_params, hinges, hinge_stiffness, theta0, out,
             not direct, self._chunk_energy, self._chunk_count,
         )
-        n_inv, n_bad = self._chunk_count.sum(axis=0)
+        n_inv, n_bad = self._chunk_count.sum(axis=0) if self._chunk_count.any() else (0, 0)
         if n_inv:
             raise ColonsimError(
                 f"{n_inv} wall triangle(s) of '{self.name}' are inverted or collapsed (det C <= 0); "
