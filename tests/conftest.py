@@ -1,5 +1,10 @@
 """Shared test fixtures."""
 
+import os
+import re
+import subprocess
+import sys
+
 import numba
 import numpy as np
 import pytest
@@ -13,6 +18,26 @@ def serial_kernels():
     numba.set_num_threads(1)
     yield
     numba.set_num_threads(previous)
+
+
+@pytest.fixture
+def two_threads(request):
+    """Checks of the threaded kernels against the serial ones run on two Numba threads: here when
+    this process has them (the test gets True and runs), else the same test again in a child
+    pytest process started with ``NUMBA_NUM_THREADS=2`` (the test gets False and returns). Under
+    the README's test command every process has one thread (conftest.py at the root), on which
+    a threaded kernel runs serially and its check could not fail on a race or a lost sum."""
+    if numba.config.NUMBA_NUM_THREADS >= 2:
+        previous = numba.get_num_threads()
+        numba.set_num_threads(2)
+        yield True
+        numba.set_num_threads(previous)
+        return
+    child = subprocess.run([sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider", request.node.nodeid],
+                           cwd=request.config.rootpath, env={**os.environ, "NUMBA_NUM_THREADS": "2"},
+                           capture_output=True, text=True, timeout=600)
+    assert child.returncode == 0 and re.search(r"^1 passed", child.stdout, re.M), child.stdout[-3000:] + child.stderr[-3000:]
+    yield False
 
 
 @pytest.fixture
