@@ -21,6 +21,15 @@ from colonsim.errors import ColonsimError
 FREE, ON_LINE, HELD = 0, 1, 2
 
 
+@numba.njit(cache=True, inline="always")
+def _along_line(x, i, point, direction):
+    """Coordinate of node ``i`` along the line through ``point`` with unit ``direction``, m."""
+    s = 0.0
+    for k in range(3):
+        s += (x[i, k] - point[k]) * direction[k]
+    return s
+
+
 @numba.njit(cache=True)
 def line_constraint_kernel(x, v_new, reaction, mass, nodes, point, direction, s_min, s_max, dt, hold=1.0):
     """Remove the velocity across the line (the fraction ``hold`` of it) on the listed nodes lying
@@ -29,9 +38,7 @@ def line_constraint_kernel(x, v_new, reaction, mass, nodes, point, direction, s_
     total = np.zeros(3)
     for j in range(nodes.shape[0]):
         i = nodes[j]
-        s = 0.0
-        for k in range(3):
-            s += (x[i, k] - point[k]) * direction[k]
+        s = _along_line(x, i, point, direction)
         if s < s_min or s > s_max:
             continue
         along = 0.0
@@ -48,15 +55,12 @@ def line_constraint_kernel(x, v_new, reaction, mass, nodes, point, direction, s_
 
 @numba.njit(cache=True)
 def nodes_on_line(x, nodes, point, direction, s_min, s_max):
-    """The listed nodes whose coordinate along the line lies within [s_min, s_max] (computed as
-    :func:`line_constraint_kernel` computes it)."""
+    """The listed nodes whose coordinate along the line lies within [s_min, s_max]."""
     inside = np.empty(nodes.shape[0], dtype=np.int64)
     n = 0
     for j in range(nodes.shape[0]):
         i = nodes[j]
-        s = 0.0
-        for k in range(3):
-            s += (x[i, k] - point[k]) * direction[k]
+        s = _along_line(x, i, point, direction)
         if s_min <= s <= s_max:
             inside[n] = i
             n += 1
