@@ -10,6 +10,7 @@ import contextlib
 import math
 import multiprocessing
 import signal
+import threading
 import uuid
 from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
 from concurrent.futures.process import BrokenProcessPool
@@ -115,15 +116,29 @@ def sigint_held():
     group would print a ``KeyboardInterrupt`` traceback; held, the signal waits until
     :func:`~colonsim.insertion.study.sweep_worker.start_worker` has installed its quiet exit and
     releases it.
+
+    The mask alone holds the signal back from this thread only: the kernel hands a process's
+    SIGINT to any thread that does not block it (BLAS starts its threads at import), and Python
+    then raises ``KeyboardInterrupt`` in the main thread wherever it is, such as between spawning
+    a worker and writing the worker its start-up data (the worker then printed ``EOFError: Ran out
+    of input``). So in the main thread Python's own handler is deferred for the block too.
     """
     if not hasattr(signal, "pthread_sigmask"):  # Windows: no signal masks (and no process groups)
         yield
         return
-    previous = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
+    deferred = threading.current_thread() is threading.main_thread()
+    if deferred:
+        came = []
+        previous_handler = signal.signal(signal.SIGINT, lambda signum, frame: came.append(signum))
+    previous_mask = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
     try:
         yield
     finally:
-        signal.pthread_sigmask(signal.SIG_SETMASK, previous)
+        signal.pthread_sigmask(signal.SIG_SETMASK, previous_mask)  # one still pending arrives now
+        if deferred:
+            signal.signal(signal.SIGINT, previous_handler)  # runs a handler still due first
+            if came:
+                signal.raise_signal(signal.SIGINT)  # to the handler before the block
 
 
 def dask_outcomes(cases, address, runner=None, log=print):
