@@ -6,8 +6,11 @@ exit code 2, no traceback.
 
 from __future__ import annotations
 
+import _thread
 import argparse
+import contextlib
 import sys
+import threading
 import warnings
 from pathlib import Path
 
@@ -230,6 +233,32 @@ def _one_line(text) -> str:
     return " ".join(str(text).split())
 
 
+@contextlib.contextmanager
+def interrupts_not_dropped():
+    """Deliver again a Ctrl-C that Python had to drop.
+
+    A ``KeyboardInterrupt`` raised where no exception can propagate (a ctypes callback, as when
+    Numba compiles a kernel; a ``__del__``) is printed as "Exception ignored" and lost: a sweep
+    interrupted in its first moments then ran on. Here such an interrupt is delivered again to the
+    main thread a moment later, once the callback has returned, and nothing is printed for it.
+    """
+    previous = sys.unraisablehook
+
+    def hook(unraisable):
+        if unraisable.exc_type is not None and issubclass(unraisable.exc_type, KeyboardInterrupt):
+            again = threading.Timer(0.05, _thread.interrupt_main)
+            again.daemon = True
+            again.start()
+        else:
+            previous(unraisable)
+
+    sys.unraisablehook = hook
+    try:
+        yield
+    finally:
+        sys.unraisablehook = previous
+
+
 def main(argv=None):
     show, shown = warnings.showwarning, set()
 
@@ -240,7 +269,7 @@ def main(argv=None):
             shown.add(_one_line(message))
             print(f"colonsim: warning: {_one_line(message)}", file=sys.stderr)
 
-    with warnings.catch_warnings():  # restores the filters and the display on return
+    with warnings.catch_warnings(), interrupts_not_dropped():  # restore the filters, the display, the hook
         warnings.simplefilter("always", ColonsimWarning)
         warnings.showwarning = show_warning
         try:
