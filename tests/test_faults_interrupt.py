@@ -51,6 +51,12 @@ def test_ctrl_c_during_a_sweep_is_one_line_and_leaves_no_process(tmp_path, after
     assert err.strip().splitlines() == ["colonsim: interrupted; files written so far are complete"]
 
 
+def _python(code):
+    """Run ``code`` in a child Python with SIGINT's default disposition, as a terminal starts it."""
+    return subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60,
+                          preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
+
+
 HELD = """
 import os, signal, threading, time
 from colonsim.insertion.study.sweep_outcomes import sigint_held
@@ -70,8 +76,7 @@ except KeyboardInterrupt:
 def test_ctrl_c_held_back_while_another_thread_takes_it():
     # the workers-importing case failed once on CI this way: Ctrl-C raised inside the held block
     # (between spawning a worker and writing its start-up data), the worker printed EOFError
-    out = subprocess.run([sys.executable, "-c", HELD], capture_output=True, text=True, timeout=60,
-                         preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
+    out = _python(HELD)
     assert out.stdout.split() == ["block", "ended", "interrupted"], out.stdout + out.stderr
 
 
@@ -98,8 +103,7 @@ with interrupts_not_dropped():
 def test_a_ctrl_c_dropped_in_a_callback_comes_again(redeliver):
     # a sweep interrupted 0.03 s after it started ran on: the parent was compiling a kernel
     code = DROPPED if redeliver else DROPPED.replace("with interrupts_not_dropped():", "if True:")
-    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60,
-                         preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
+    out = _python(code)
     if redeliver:
         assert out.stdout.split() == ["interrupted"] and "Exception ignored" not in out.stderr, out.stdout + out.stderr
     else:  # the case the hook exists for: without it the interrupt is lost
