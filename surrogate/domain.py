@@ -69,8 +69,9 @@ class SegmentDomain:
         parts += [f"{n} = {v:g} (fixed)" for n, v in self.fixed.items()]
         return f"{self.segment}: {self.n_runs} runs; " + ", ".join(parts)
 
-    def matrix(self, query: dict, n=None):
-        """The model's input matrix (n, d) from ``query`` (input name -> scalar or array).
+    def _matrix(self, query: dict, n=None):
+        """The model's input matrix (n, d) from ``query`` (input name -> float array, as
+        :meth:`check` has read it with :meth:`numbers`).
 
         Inputs the model does not have are checked against their fixed value by :meth:`check`,
         not used here. A missing model input is an error naming it and its range."""
@@ -79,10 +80,12 @@ class SegmentDomain:
             ranges = ", ".join(f"{m} ({self.low[self.inputs.index(m)]:g}-{self.high[self.inputs.index(m)]:g} in the runs; "
                                f"{INPUT_OPTIONS.get(m, m)} on the command line)" for m in missing)
             raise ColonsimError(f"segment {self.segment}: give {ranges}; the surrogate depends on it")
-        cols = [self.numbers(query[name], name) for name in self.inputs]
+        cols = [query[name] for name in self.inputs]
         if n is None:
             n = max([len(c) for c in cols], default=1)
-        X = np.column_stack([np.broadcast_to(c, (n,)) for c in cols]) if cols else np.zeros((n, 0))
+        X = np.empty((n, len(cols)))
+        for j, c in enumerate(cols):
+            X[:, j] = c  # a single value fills its column
         if np.isnan(X).any():
             i, j = np.argwhere(np.isnan(X))[0]
             raise ColonsimError(f"segment {self.segment}: query {i + 1} lacks {self.inputs[j]}; the surrogate depends on it")
@@ -98,6 +101,8 @@ class SegmentDomain:
         or an infinite value is an error naming the query and the input."""
         if isinstance(values, np.ndarray) and values.dtype == np.float64:
             raw, out = None, np.atleast_1d(values)
+        elif isinstance(values, (float, int, np.floating, np.integer)):  # one query's value: no object array
+            raw, out = None, np.array([float(values)])
         else:
             raw = np.atleast_1d(np.asarray(values, dtype=object))
             try:
@@ -106,31 +111,32 @@ class SegmentDomain:
                 i = next(i for i, v in enumerate(raw) if not _is_number(v))
                 raise ColonsimError(f"segment {self.segment}: query {i + 1} has {name} = {raw[i]!r}; "
                                     "give a number") from None
-        infinite = np.flatnonzero(np.isinf(out))
-        if infinite.size:
-            i = infinite[0]
+        infinite = np.isinf(out)
+        if infinite.any():
+            i = np.flatnonzero(infinite)[0]
             shown = float(out[i]) if raw is None else raw[i]
             raise ColonsimError(f"segment {self.segment}: query {i + 1} has {name} = {shown!r}; give a finite number")
         return out
 
-    def check_ranges(self, query: dict):
+    def _check_ranges(self, query: dict):
         """Refuse a query value no insertion accepts (a negative diameter, friction above 2, ...):
-        the ranges of :data:`colonsim.input_ranges.INPUT_RANGES`, which ``colonsim insert`` applies too."""
-        for name, values in query.items():
-            if name in INPUT_RANGES and values is not None:
-                low, high, _ = INPUT_RANGES[name]
-                numbers = self.numbers(values, name)
-                with np.errstate(invalid="ignore"):
-                    outside = np.flatnonzero(~((low <= numbers) & (numbers <= high)) & ~np.isnan(numbers))
-                if outside.size:  # the first one, in the words of colonsim insert
-                    i = outside[0]
-                    check_input_range(name, numbers[i], f"segment {self.segment}: query {i + 1}: ")
+        the ranges of :data:`colonsim.input_ranges.INPUT_RANGES`, which ``colonsim insert`` applies too.
+        ``query``: input name -> float array (:meth:`check` has read it)."""
+        with np.errstate(invalid="ignore"):
+            for name, numbers in query.items():
+                if name in INPUT_RANGES and numbers is not None:
+                    low, high, _ = INPUT_RANGES[name]
+                    outside = (numbers < low) | (numbers > high)  # NaN (not given) is neither
+                    if outside.any():  # the first one, in the words of colonsim insert
+                        i = np.flatnonzero(outside)[0]
+                        check_input_range(name, numbers[i], f"segment {self.segment}: query {i + 1}: ")
 
-    def unknown_inputs(self, query: dict) -> list:
+    def _unknown_inputs(self, query: dict) -> list:
         """Candidate inputs the query sets but the model has neither as an input nor as a fixed
-        value (the results table had no such column): the model cannot answer for them."""
+        value (the results table had no such column): the model cannot answer for them.
+        ``query``: input name -> float array (:meth:`check` has read it)."""
         return [name for name in INPUTS if name not in self.inputs and name not in self.fixed
-                and query.get(name) is not None and not np.isnan(self.numbers(query[name], name)).all()]
+                and query.get(name) is not None and not np.isnan(query[name]).all()]
 
     def check(self, query: dict, n=None, strict=False, warn=True):
         """The model's input matrix of ``query`` and the rows outside the domain.
@@ -139,16 +145,17 @@ class SegmentDomain:
         the offending inputs ("" inside). Raises :class:`ColonsimError` with ``strict``; otherwise warns once
         (:class:`OutOfDomainWarning`) when ``warn``."""
         # each value a number once, not in every check below (a query's cost: measured)
-        query = {name: self.numbers(values, name) if values is not None and name in self._numeric else values
+        numeric = self._numeric
+        query = {name: self.numbers(values, name) if values is not None and name in numeric else values
                  for name, values in query.items()}
-        self.check_ranges(query)
-        unknown = self.unknown_inputs(query)
+        self._check_ranges(query)
+        unknown = self._unknown_inputs(query)
         if unknown:
             options = ", ".join(INPUT_OPTIONS.get(u, u) for u in unknown)
             raise ColonsimError(f"segment {self.segment}: the surrogate was fitted on a table without "
                                 f"{', '.join(unknown)}, so it cannot take it into account; leave {options} out of the "
                                 "query or refit on a results table with that column")
-        X = self.matrix(query, n)
+        X = self._matrix(query, n)
         reasons = [[] for _ in range(len(X))]
         span = np.maximum(self.high - self.low, 0.0)
         below = X < self.low - TOLERANCE * span
@@ -160,16 +167,17 @@ class SegmentDomain:
             raise ColonsimError(f"segment {self.segment}: query {i + 1} has {self.inputs[j]} = {X[i, j]:g}, more than "
                                 f"{FAR:,.0f} times the training range ({self.low[j]:g}-{self.high[j]:g}) outside it; "
                                 "check the value and its unit")
-        for j, name in enumerate(self.inputs):
-            for i in np.flatnonzero(below[:, j] | above[:, j]):
-                reasons[i].append(f"{name} {X[i, j]:g} outside {self.low[j]:g}-{self.high[j]:g}")
+        outside = below | above
+        for j in np.flatnonzero(outside.any(axis=0)):  # (the per-input loops cost a query's time)
+            for i in np.flatnonzero(outside[:, j]):
+                reasons[i].append(f"{self.inputs[j]} {X[i, j]:g} outside {self.low[j]:g}-{self.high[j]:g}")
         for name, value in self.fixed.items():
             given = query.get(name)
             if given is None:
                 continue
-            arr = np.broadcast_to(self.numbers(given, name), (len(X),))
+            arr = np.broadcast_to(given, (len(X),))
             off = np.abs(arr - value) > TOLERANCE * max(1.0, abs(value))  # NaN = not given: not off
-            for i in np.flatnonzero(off):
+            for i in np.flatnonzero(off) if off.any() else ():
                 reasons[i].append(f"{name} {arr[i]:g} but every {self.segment} run used {value:g}")
         text = ["; ".join(r) for r in reasons]
         inside = np.array([not r for r in reasons], dtype=bool)

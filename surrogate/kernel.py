@@ -14,16 +14,27 @@ import numpy as np
 SQRT5 = np.sqrt(5.0)
 
 
+def scaled_rows(X, length_scale):
+    """The rows of ``X`` (m, d) divided by their length scales, and their squared norms (m,): the
+    half of a distance that a set of rows keeps from query to query (one per row of length scales
+    of shape (k, 1, d): (k, m, d) and (k, m))."""
+    A = np.asarray(X, dtype=float) / length_scale
+    return A, np.einsum("...ij,...ij->...i", A, A)
+
+
+def distance_of_scaled(A, a2, B, b2):
+    """Euclidean distance (m, n) between scaled rows ``A`` and ``B`` with squared norms ``a2`` and
+    ``b2`` (:func:`scaled_rows`)."""
+    # |a - b|^2 = |a|^2 + |b|^2 - 2 a.b: one matrix product instead of an (m, n, d) tensor
+    sq = a2[..., :, None] + b2[..., None, :] - 2.0 * (A @ np.swapaxes(B, -1, -2))
+    return np.sqrt(np.maximum(sq, 0.0))
+
+
 def scaled_distance(XA, XB, length_scale):
     """Euclidean distance between the rows of ``XA`` (m, d) and ``XB`` (n, d), each input divided by
     its length scale; (m, n). Length scales of shape (k, 1, d) give one distance matrix per row
     of them, (k, m, n)."""
-    A = np.asarray(XA, dtype=float) / length_scale
-    B = np.asarray(XB, dtype=float) / length_scale
-    # |a - b|^2 = |a|^2 + |b|^2 - 2 a.b: one matrix product instead of an (m, n, d) tensor
-    sq = (np.einsum("...ij,...ij->...i", A, A)[..., :, None] + np.einsum("...ij,...ij->...i", B, B)[..., None, :]
-          - 2.0 * (A @ np.swapaxes(B, -1, -2)))
-    return np.sqrt(np.maximum(sq, 0.0))
+    return distance_of_scaled(*scaled_rows(XA, length_scale), *scaled_rows(XB, length_scale))
 
 
 def matern52_of_distance(r):
