@@ -100,13 +100,14 @@ def cmd_demo(args):
     from colonsim.demo import DemoOptions, run_demo
 
     check_input_range("element_size_mm", args.element_size, "--element-size: ")  # before the calibration runs
-    if args.scope_spacing is not None:  # the case's own range check, before the calibration runs
-        from colonsim.insertion.case.insertion_case import InsertionCase
-
-        InsertionCase(scope_spacing_mm=args.scope_spacing).validate()
+    # the case's own range checks, before the calibration runs
+    for field, value in (("scope_spacing_mm", args.scope_spacing), ("push_speed", args.push_speed)):
+        if value is not None:
+            InsertionCase(**{field: value}).validate()
 
     run_demo(DemoOptions(out=args.out, element_size_mm=args.element_size, scope_spacing_mm=args.scope_spacing,
-                         workers=args.workers, show_progress=not args.no_progress, target=args.target))
+                         push_speed=args.push_speed, workers=args.workers, show_progress=not args.no_progress,
+                         target=args.target))
 
 
 def _add_insert(sub):
@@ -220,6 +221,9 @@ def build_parser():
     demo.add_argument("--scope-spacing", type=finite_float, default=None,
                       help=f"scope node spacing of the insertions and the sweep, mm (default "
                            f"{InsertionCase.scope_spacing_mm:g}; coarser is faster, not validated)")
+    demo.add_argument("--push-speed", type=finite_float, default=None,
+                      help=f"push speed of the insertions and the sweep, m/s (default {InsertionCase.push_speed:g}, "
+                           "quasi-static; faster is cheaper and rings, not validated)")
     demo.add_argument("--workers", type=worker_count, default=None,
                       help="processes for the demo's sweep (default: up to 2 cores)")
     demo.add_argument("--no-progress", action="store_true", help="no progress bar")

@@ -30,8 +30,7 @@ description = "colonsim demo: RSJ x UTC/PDC/SDC x D 23/36 mm x mu 0/0.1 (12 runs
 
 [fixed]
 material = "{material}"
-element_size_mm = {element_size}
-scope_spacing_mm = {scope_spacing}
+{size}
 
 [[grid]]
 segment = "rsj"
@@ -49,8 +48,7 @@ description = "4 cases of the demo sweep on a 7 % finer wall mesh (the simulatio
 
 [fixed]
 material = "{material}"
-element_size_mm = {element_size}
-scope_spacing_mm = {scope_spacing}
+{size}
 friction = 0.1
 
 [[grid]]
@@ -82,7 +80,22 @@ def calibrate_step(out: Path, show: bool):
     return calibrate(CalibrationRequest(law="mooney_rivlin_3", quick=True, workers=1, show_progress=show), out)[0]
 
 
-def insertion_step(material: Path, element_size: float, scope_spacing: float, out: Path, show: bool):
+def _toml(size: dict) -> str:
+    """The run size (:func:`run_size`) as lines of a sweep's ``[fixed]`` table."""
+    return "\n".join(f"{name} = {value!r}" for name, value in size.items())
+
+
+def run_size(element_size: float, scope_spacing: float, push_speed: float | None) -> dict:
+    """The inputs of every demo insertion that set its cost: wall mesh and scope node spacing (mm)
+    and, when given, the push speed (m/s; absent: the model's default, and the case keys of
+    earlier demos)."""
+    size = {"element_size_mm": element_size, "scope_spacing_mm": scope_spacing}
+    if push_speed is not None:
+        size["push_speed"] = push_speed
+    return size
+
+
+def insertion_step(material: Path, size: dict, out: Path, show: bool):
     from colonsim.workflows import insert
     from colonsim.insertion.case.scenario import InsertionCase
 
@@ -95,8 +108,7 @@ def insertion_step(material: Path, element_size: float, scope_spacing: float, ou
     # insert --threads 2` is the faster choice on an idle machine.
     numba.set_num_threads(1)
     # the material named as the sweep names it, so that these three runs are cases of the sweep
-    cases = [InsertionCase(segment="rsj", scope=s, diameter_mm=36.0, material=material.resolve().as_posix(),
-                           element_size_mm=element_size, scope_spacing_mm=scope_spacing)
+    cases = [InsertionCase(segment="rsj", scope=s, diameter_mm=36.0, material=material.resolve().as_posix(), **size)
              for s in ("utc", "pdc", "sdc")]
     return insert(cases, out, show=show)
 
@@ -119,13 +131,11 @@ def record_step_runs(spec, insertions, out: Path) -> int:
     return len(new)
 
 
-def sweep_step(material: Path, element_size: float, scope_spacing: float, out: Path, workers: int, show: bool,
-               insertions=()):
+def sweep_step(material: Path, size: dict, out: Path, workers: int, show: bool, insertions=()):
     from colonsim.insertion.study.sweep import run_sweep
     from colonsim.insertion.study.sweep_spec import parse_sweep
 
-    text = DEMO_SWEEP.format(material=material.resolve().as_posix(), element_size=element_size,
-                             scope_spacing=scope_spacing)
+    text = DEMO_SWEEP.format(material=material.resolve().as_posix(), size=_toml(size))
     spec = parse_sweep(text, origin="demo sweep")
     _section(f"3/5 sweep: {spec.description.split(': ', 1)[1]} on {workers} local process"
              f"{'es' if workers > 1 else ''}")
@@ -140,9 +150,8 @@ def sweep_step(material: Path, element_size: float, scope_spacing: float, out: P
             "final_deformation_cm", "peak_contact_force_N", "wall_time_s"]
     table = report.table.sort_values(["diameter_mm", "friction", "scope_diameter_mm"])[cols]
     print(table.to_string(index=False, float_format=lambda v: f"{v:.3g}"))
-    text = DEMO_REPLICATES.format(material=material.resolve().as_posix(),
-                                  element_size=round(REPLICATE_MESH * element_size, 3),
-                                  scope_spacing=scope_spacing)
+    finer = {**size, "element_size_mm": round(REPLICATE_MESH * size["element_size_mm"], 3)}
+    text = DEMO_REPLICATES.format(material=material.resolve().as_posix(), size=_toml(finer))
     spec = parse_sweep(text, origin="demo replicates")
     print(f"replicates: {spec.description}")
     again = run_sweep(spec.cases, out.with_name("replicates"), workers=workers, spec=spec, progress=show)
@@ -195,8 +204,7 @@ def _cell(v) -> str:
     return f"{v:.3g}" if isinstance(v, float) else str(v)
 
 
-def write_report(out: Path, calibration, insertions, sweep, model, recs, seconds: dict, element_size: float,
-                 scope_spacing: float):
+def write_report(out: Path, calibration, insertions, sweep, model, recs, seconds: dict, size: dict):
     """``report.md``: what the demo ran, its main numbers and where each file is."""
     from colonsim.files import atomic_path
     from colonsim.markdown import frame_table
@@ -204,9 +212,12 @@ def write_report(out: Path, calibration, insertions, sweep, model, recs, seconds
     from colonsim.surrogate.recommend import format_recommendation
 
     sd = dict(zip(calibration.names, calibration.uncertainty.std))
+    speed = (f", pushed at {size['push_speed']:g} m/s (not the model's quasi-static default: faster and cheaper, "
+             "its numbers ring)" if "push_speed" in size else "")
     lines = ["# colonsim demo", "",
              "Generated by `colonsim demo`. Calibration on the bundled SYNTHETIC tensile curves with a reduced "
-             f"budget; insertions on a {element_size:g} mm wall mesh with scope nodes every {scope_spacing:g} mm. "
+             f"budget; insertions on a {size['element_size_mm']:g} mm wall mesh with scope nodes every "
+             f"{size['scope_spacing_mm']:g} mm{speed}. "
              "Run times on this machine: "
              + ", ".join(f"{k} {v:.0f} s" for k, v in seconds.items()) + ".", "",
              "## 1. Calibration (`calibration/`)", ""]
@@ -266,12 +277,13 @@ def print_summary(calibration, insertions, model, recs, target=PAIN_PROXY):
 @dataclass(frozen=True)
 class DemoOptions:
     """Where the demo writes, its wall mesh and scope node spacing (mm; None: the model's default),
-    sweep processes (None: up to 2 cores), bars, and the deformation the summary and the
-    recommendations rank by."""
+    its push speed (m/s; None: the model's default), sweep processes (None: up to 2 cores), bars,
+    and the deformation the summary and the recommendations rank by."""
 
     out: Path = Path("colonsim_demo")
     element_size_mm: float = 3.0
     scope_spacing_mm: float | None = None
+    push_speed: float | None = None
     workers: int | None = None
     show_progress: bool = True
     target: str = PAIN_PROXY
@@ -287,23 +299,23 @@ def run_demo(options: DemoOptions):
         from colonsim.insertion.case.insertion_case import InsertionCase
 
         scope_spacing = InsertionCase.scope_spacing_mm  # the model's default
+    size = run_size(options.element_size_mm, scope_spacing, options.push_speed)
     seconds = {}
     t0 = time.perf_counter()
     calibration = calibrate_step(out / "calibration", show)
     seconds["calibration"] = time.perf_counter() - t0
     material = out / "calibration" / "material.json"
     t = time.perf_counter()
-    insertions = insertion_step(material, options.element_size_mm, scope_spacing, out / "insertion", show)
+    insertions = insertion_step(material, size, out / "insertion", show)
     seconds["insertions"] = time.perf_counter() - t
     t = time.perf_counter()
-    sweep = sweep_step(material, options.element_size_mm, scope_spacing, out / "sweep", workers, show, insertions)
+    sweep = sweep_step(material, size, out / "sweep", workers, show, insertions)
     seconds["sweep"] = time.perf_counter() - t
     t = time.perf_counter()
     model, _, _ = surrogate_step(out / "sweep" / "results.parquet", out / "replicates" / "results.parquet", out)
     recs = recommend_step(model, out, options.target)
     seconds["surrogate and recommendations"] = time.perf_counter() - t
-    report = write_report(out, calibration, insertions, sweep, model, recs, seconds, options.element_size_mm,
-                          scope_spacing)
+    report = write_report(out, calibration, insertions, sweep, model, recs, seconds, size)
     print_summary(calibration, insertions, model, recs, options.target)
     print(f"\ndemo finished in {time.perf_counter() - t0:.0f} s; report: {report}; every file in {out}/")
     print("Next: `colonsim sweep --preset thesis` runs the source's 39 insertions; `colonsim surrogate fit` and "

@@ -204,6 +204,7 @@ CASES = [
     (["demo", "--out", "{ws}/a_file"], "a_file is an existing file"),
     (["demo", "--workers", "0", "--out", "{ws}/good_demo"], "must be at least 1"),
     (["demo", "--element-size", "inf", "--out", "{ws}/good_demo"], "'inf' is not a finite number"),
+    (["demo", "--push-speed", "0", "--out", "{ws}/good_demo"], "push_speed = 0.0 is outside [0.001, 5]"),
     (["simulate"], "invalid choice: 'simulate'"),
     ([], "the following arguments are required: command"),
 ]

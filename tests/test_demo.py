@@ -1,8 +1,9 @@
 """``colonsim demo`` end to end on a coarse wall mesh: every step runs and writes what the README promises.
 
 The full demo uses the 3 mm mesh (a few minutes on 2 cores); the smoke size (a 5 mm wall mesh,
-scope nodes every 10 mm: colonsim.catalog) keeps this check near two minutes. Its numbers are not
-physics (too coarse), so only their consistency is checked.
+scope nodes every 10 mm, pushed at 0.6 m/s: colonsim.catalog) keeps this check near four minutes
+on a slow machine. Its numbers are not physics (too coarse, too fast), so only their consistency
+is checked.
 """
 
 import json
@@ -10,7 +11,7 @@ import json
 import pandas as pd
 import pytest
 
-from colonsim.catalog import SMOKE_ELEMENT_MM, SMOKE_SCOPE_SPACING_MM
+from colonsim.catalog import SMOKE_ELEMENT_MM, SMOKE_PUSH_SPEED, SMOKE_SCOPE_SPACING_MM
 from colonsim.cli import main
 from colonsim.demo import REPLICATE_MESH
 
@@ -19,7 +20,8 @@ from colonsim.demo import REPLICATE_MESH
 def test_demo_runs_every_workflow_and_writes_one_folder(tmp_path, capsys):
     out = tmp_path / "demo"
     assert main(["demo", "--out", str(out), "--element-size", str(SMOKE_ELEMENT_MM),
-                 "--scope-spacing", str(SMOKE_SCOPE_SPACING_MM), "--no-progress"]) in (None, 0)
+                 "--scope-spacing", str(SMOKE_SCOPE_SPACING_MM), "--push-speed", str(SMOKE_PUSH_SPEED),
+                 "--no-progress"]) in (None, 0)
     text = capsys.readouterr().out
     for step in ("1/5", "2/5", "3/5", "4/5", "5/5", "summary"):
         assert f"== {step}" in text
@@ -54,7 +56,9 @@ def test_demo_runs_every_workflow_and_writes_one_folder(tmp_path, capsys):
         means = [s["mean"] for s in rec["scopes"]]
         assert means == sorted(means)  # the ranking is by predicted deformation
     report = (out / "report.md").read_text()
-    assert f"{SMOKE_ELEMENT_MM:g} mm wall mesh with scope nodes every {SMOKE_SCOPE_SPACING_MM:g} mm" in report
+    assert (f"{SMOKE_ELEMENT_MM:g} mm wall mesh with scope nodes every {SMOKE_SCOPE_SPACING_MM:g} mm, pushed at "
+            f"{SMOKE_PUSH_SPEED:g} m/s") in report
+    assert set(table["push_speed"]) == set(replicates["push_speed"]) == {SMOKE_PUSH_SPEED}
     assert "![RSJ insertions](insertion/comparison.png)" in report
     for figure in ("insertion/comparison.png", "surrogate_vs_diameter_mm.png", "surrogate_vs_friction.png"):
         assert (out / figure).stat().st_size > 10_000

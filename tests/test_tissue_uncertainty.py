@@ -12,7 +12,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from colonsim.catalog import SMOKE_ELEMENT_MM, SMOKE_SCOPE_SPACING_MM, WALL_C11, WALL_MU0
+from colonsim.catalog import SMOKE_ELEMENT_MM, SMOKE_PUSH_SPEED, SMOKE_SCOPE_SPACING_MM, WALL_C11, WALL_MU0
 from colonsim.cli import main
 from colonsim.errors import ColonsimError
 from colonsim.surrogate import OutOfDomainWarning, SegmentDomain, SweepSurrogate
@@ -231,6 +231,7 @@ def test_a_real_sweep_over_drawn_materials_end_to_end(tmp_path, capsys):
 
     material_file(tmp_path, mean=[14_400.0, 33_000.0, 153_000.0], cov=np.diag([4e6, 4e6, 9e6]))
     spec = parse_sweep(f'[fixed]\nelement_size_mm = {SMOKE_ELEMENT_MM}\nscope_spacing_mm = {SMOKE_SCOPE_SPACING_MM}\n'
+                       f'push_speed = {SMOKE_PUSH_SPEED}\n'
                        '[[grid]]\nsegment = "rsj"\nscope = ["utc", "sdc"]\n'
                        '[material]\nfile = "material.json"\nsamples = 2\nseed = 2\n', base=tmp_path)
     report = run_sweep(spec.cases, tmp_path / "sweep", workers=2, spec=spec, progress=False, log=lambda *a: None)

@@ -7,6 +7,7 @@ import json
 import numpy as np
 import pytest
 
+from colonsim.catalog import SMOKE_PUSH_SPEED
 from colonsim.errors import ColonsimError
 from colonsim.insertion.case.scenario import InsertionCase, run_insertion
 from colonsim.insertion.engine.material import load_material
@@ -78,13 +79,15 @@ def test_law_derivatives_are_consistent(name):
 @pytest.mark.parametrize("name, last", [("yeoh", "C30"), ("ogden_3", "alpha3")])
 def test_material_file_runs_an_insertion(tmp_path, name, last):
     """What ``colonsim calibrate --law yeoh`` (or ``ogden_3``) writes, ``colonsim insert --material``
-    runs: the file loads, and a straight push on a coarse mesh reaches the far end."""
+    runs: the file loads, and a straight push on a coarse mesh, at the smoke push speed, reaches the
+    far end."""
     law = WALL_LAWS[name]
     path = tmp_path / "material.json"
     params = dict(zip(law.parameter_names, CHECK_MATERIALS[name].parameters))
     path.write_text(json.dumps({"law": name, "units": "Pa", "parameters": params}))
     assert load_material(path) == CHECK_MATERIALS[name]
-    result = run_insertion(InsertionCase(segment="straight", scope="pdc", element_size_mm=8.0, material=str(path)))
+    result = run_insertion(InsertionCase(segment="straight", scope="pdc", element_size_mm=8.0, material=str(path),
+                                         push_speed=SMOKE_PUSH_SPEED))
     s = result.summary
     assert s["ended_by"] == "far_end" and s["material"]["law"] == name and s["material"][last] == params[last]
     assert result.model.shell.material.law == name

@@ -2,7 +2,7 @@
 :mod:`colonsim.insertion.study.sweep_spec` reads, one entry per preset.
 """
 
-from colonsim.catalog import SMOKE_ELEMENT_MM, SMOKE_SCOPE_SPACING_MM
+from colonsim.catalog import SMOKE_ELEMENT_MM, SMOKE_PUSH_SPEED, SMOKE_SCOPE_SPACING_MM
 from colonsim.insertion.case.insertion_case import InsertionCase
 
 # The rate check's push speed: half the default (docs/model.md, "Time integration and damping").
@@ -120,11 +120,12 @@ push_speed = {HALF_SPEED:g}
     "smoke": f"""
 [sweep]
 name = "smoke"
-description = "Three fast runs on a coarse {SMOKE_ELEMENT_MM:g} mm wall mesh (tests, setup checks); not physics"
+description = "Three fast runs on a coarse {SMOKE_ELEMENT_MM:g} mm wall mesh, pushed at {SMOKE_PUSH_SPEED:g} m/s (tests, setup checks); not physics"
 
 [fixed]
 element_size_mm = {SMOKE_ELEMENT_MM}
 scope_spacing_mm = {SMOKE_SCOPE_SPACING_MM}
+push_speed = {SMOKE_PUSH_SPEED}
 
 [[grid]]
 segment = "straight"
