@@ -135,6 +135,9 @@ def _add_insert(sub):
     p.add_argument("--scope-spacing", type=finite_float, default=None,
                    help=f"scope node spacing, mm (default {InsertionCase.scope_spacing_mm:g}; coarser is faster, not "
                         "validated)")
+    p.add_argument("--push-speed", type=finite_float, default=InsertionCase.push_speed,
+                   help=f"plateau push speed, m/s (default {InsertionCase.push_speed:g}, quasi-static; the source "
+                        "pushed at 0.6; half of it checks the rate: docs/model.md, \"Loading\")")
     p.add_argument("--material", help="material JSON from colonsim calibrate (default: the source's parameters)")
     p.add_argument("--flexure-angle", type=finite_float, default=90.0,
                    help="turn of the splenic (RSF) or hepatic (THF) flexure, degrees (default 90, an assumption)")
@@ -182,7 +185,7 @@ def cmd_insert(args):
                            wall_thickness_mm=args.wall_thickness,
                            element_size_mm=args.element_size, material=args.material,
                            exit_length_mm=args.exit_length, distal_resistance_N=args.distal_resistance,
-                           **({} if args.scope_spacing is None else {"scope_spacing_mm": args.scope_spacing}))
+                           push_speed=args.push_speed, **({} if args.scope_spacing is None else {"scope_spacing_mm": args.scope_spacing}))
              for scope in args.scope]
     if args.material is not None:
         from colonsim.inputs import check_input

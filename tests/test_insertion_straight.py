@@ -4,6 +4,7 @@ import json
 
 import pytest
 
+from colonsim.catalog import SMOKE_PUSH_SPEED
 from colonsim.cli import main
 from colonsim.insertion.case.scenario import InsertionCase, chunk_seconds, run_insertion
 
@@ -54,13 +55,15 @@ def test_a_sliding_scope_is_not_dragged(straight_run):
 def test_cli_insert_writes_results_and_rejects_bad_input(tmp_path, capsys):
     out = tmp_path / "ins"
     assert main(["insert", "--segment", "straight", "--scope", "utc", "--element-size", "4", "--no-progress",
-                 "--out", str(out)]) == 0
+                 "--push-speed", str(SMOKE_PUSH_SPEED), "--out", str(out)]) == 0
     summary = json.loads((out / "straight_UTC" / "summary.json").read_text())
     assert summary["mesh"]["wall_triangles"] > 0 and summary["inputs"]["scope"] == "utc"
+    assert summary["inputs"]["push_speed"] == SMOKE_PUSH_SPEED
     assert (out / "comparison.csv").is_file() and (out / "straight_UTC" / "timeseries.csv").is_file()
     for args, message in ((["--scope", "36", "--diameter", "23"], "outside 3-20 mm"),
                           (["--scope", "15", "--diameter", "15"], "as wide as or wider than the colon"),
                           (["--friction", "-0.1"], "friction"),
+                          (["--push-speed", "0"], "push_speed = 0.0 is outside [0.001, 5]"),
                           (["--diameter", "-5"], "diameter_mm"),
                           (["--material", str(tmp_path / "none.json")], "not found")):
         capsys.readouterr()

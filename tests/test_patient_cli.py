@@ -9,7 +9,7 @@ import pandas as pd
 import pytest
 from centerline_files import PLAIN, hairpin, loop
 
-from colonsim.catalog import SMOKE_ELEMENT_MM, SMOKE_SCOPE_SPACING_MM
+from colonsim.catalog import SMOKE_ELEMENT_MM, SMOKE_PUSH_SPEED, SMOKE_SCOPE_SPACING_MM
 from colonsim.cli import main
 from colonsim.data import data_path
 from colonsim.errors import ColonsimError
@@ -73,8 +73,8 @@ def test_bad_centerline_is_one_line_exit_2_and_nothing_written(files, args, mess
 def test_a_patient_runs_from_the_command_line(files, capsys):
     out = files / "run"
     assert main(["insert", "--centerline", str(files / "profile.csv"), "--scope", "utc", "--element-size",
-                 str(SMOKE_ELEMENT_MM), "--scope-spacing", str(SMOKE_SCOPE_SPACING_MM), "--no-progress",
-                 "--out", str(out)]) == 0
+                 str(SMOKE_ELEMENT_MM), "--scope-spacing", str(SMOKE_SCOPE_SPACING_MM), "--push-speed",
+                 str(SMOKE_PUSH_SPEED), "--no-progress", "--out", str(out)]) == 0
     summary = json.loads((out / "patient_UTC" / "summary.json").read_text())
     # the diameters at the ranges' first points (40, 30, 40 mm) interpolated along the points: median 36.6
     assert summary["inputs"]["segment"] == "patient" and summary["inputs"]["diameter_mm"] == 36.6
