@@ -90,7 +90,7 @@ def test_a_new_colon_model_is_one_entry(monkeypatch, tmp_path):
     monkeypatch.setitem(COLON_MODELS, "tube", tube)
     g = colon_geometry("tube", 0.036, 0.0, COARSE_MM * 1e-3, 2e-3)
     assert g.name == "tube"
-    case = InsertionCase(segment="tube", element_size_mm=7.5)
+    case = InsertionCase(segment="tube", element_size_mm=7.5, push_speed=catalog.SMOKE_PUSH_SPEED)
     case.validate()
     assert build_insertion(case).rod.rest_length.sum() == pytest.approx(0.35, rel=1e-12)
     result = run_insertion(case)

@@ -7,6 +7,7 @@ import re
 import pytest
 
 from colonsim.cli import main
+from colonsim.catalog import SMOKE_PUSH_SPEED
 from colonsim.errors import ColonsimError
 from colonsim.insertion.engine.material import REFERENCE_MATERIAL_PATH
 from colonsim.insertion.case.run_budget import check_run_budget, check_sweep_budget, estimate_run
@@ -25,7 +26,7 @@ def stiffer(tmp_path, factor):
 
 def test_the_estimate_is_printed_and_close_to_the_steps_taken(tmp_path, capsys):
     assert main(["insert", "--segment", "straight", "--scope", "pdc", "--element-size", "7.5", "--no-progress",
-                 "--out", str(tmp_path)]) == 0
+                 "--push-speed", str(SMOKE_PUSH_SPEED), "--out", str(tmp_path)]) == 0
     out = capsys.readouterr().out
     estimated = int(re.search(r"about ([\d,]+) time steps", out).group(1).replace(",", ""))
     taken = int(re.search(r"(\d+) steps in", out).group(1))
