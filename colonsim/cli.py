@@ -185,7 +185,8 @@ def cmd_insert(args):
                            wall_thickness_mm=args.wall_thickness,
                            element_size_mm=args.element_size, material=args.material,
                            exit_length_mm=args.exit_length, distal_resistance_N=args.distal_resistance,
-                           push_speed=args.push_speed, **({} if args.scope_spacing is None else {"scope_spacing_mm": args.scope_spacing}))
+                           push_speed=args.push_speed,
+                           **({} if args.scope_spacing is None else {"scope_spacing_mm": args.scope_spacing}))
              for scope in args.scope]
     if args.material is not None:
         from colonsim.inputs import check_input

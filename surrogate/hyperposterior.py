@@ -124,7 +124,7 @@ class Mixture:
 
     def __init__(self, X, y, thetas):
         thetas = np.atleast_2d(np.asarray(thetas, dtype=float))
-        self.X, self.thetas = X, thetas
+        self.X, self.thetas = np.ascontiguousarray(X, dtype=float), thetas
         self.constant = np.exp(thetas[:, 0])
         self.length_scale = np.exp(thetas[:, 1:-1])
         self.noise = np.exp(thetas[:, -1])
@@ -162,8 +162,8 @@ class Mixture:
             return means.mean(axis=0), covs.mean(axis=0) + spread.T @ spread / len(means)
         if len(Q) <= FEW_ROWS:
             mean, var = np.empty(len(Q)), np.empty(len(Q))
-            few_rows_moments(np.ascontiguousarray(Q, dtype=float), np.ascontiguousarray(self.X, dtype=float),
-                             self._inv_length, self.constant, self.alpha, self.L_inv, self.noise, return_var, mean, var)
+            few_rows_moments(np.ascontiguousarray(Q, dtype=float), self.X, self._inv_length, self.constant,
+                             self.alpha, self.L_inv, self.noise, return_var, mean, var)
             return (mean, var) if return_var else mean
         if len(Q) >= ONE_THREAD_ROWS:
             from threadpoolctl import threadpool_limits
