@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from colonsim.insertion.case.outcomes import (JAM_FORCE, JAM_PROGRESS, JAM_PUSH, characteristic_points, jammed,
+from colonsim.insertion.case.outcomes import (JAM_FORCE, JAM_PROGRESS, JAM_PUSH, arc_along, characteristic_points, jammed,
                                               principal_stretches, quasi_static_fraction, ringing_wavelength,
                                               sliding_kinetic_energy)
 
@@ -170,3 +170,31 @@ def test_ringing_wavelength_needs_two_windows_of_push_after_contact():
     late = z > 0.285  # contact begins 1.5 cm before the end of the push
     assert np.isnan(ringing_wavelength(z, f, late))
     assert np.isnan(ringing_wavelength(z, f, np.zeros(z.size, dtype=bool)))
+
+
+def test_the_tip_position_along_a_bend_is_its_arc_length_between_samples():
+    """A 90 deg bend of radius 5 cm sampled every millimetre: a point at any angle, on the curve or
+    1 cm inside it, reads R theta (within 1e-7 m: the interpolation errs by about h^3 / R^2, 0.4
+    micrometres for h = 1 mm, and far less inside a segment), not the nearest sample's arc (up to
+    0.5 mm away); a point before the start or past the end reads the end's arc."""
+    radius = 0.05
+    arc = np.linspace(0.0, 0.5 * np.pi * radius, int(0.5 * np.pi * radius / 1e-3) + 1)
+    angle = arc / radius
+    points = radius * np.column_stack([np.sin(angle), 1.0 - np.cos(angle), np.zeros_like(arc)])
+    tangents = np.column_stack([np.cos(angle), np.sin(angle), np.zeros_like(arc)])
+    for theta in np.linspace(0.01, 1.5, 37):
+        for r in (radius, radius - 0.01):
+            p = np.array([r * np.sin(theta), radius - r * np.cos(theta), 0.003])
+            assert arc_along(points, arc, tangents, p) == pytest.approx(radius * theta, abs=1e-7)
+    assert arc_along(points, arc, tangents, np.array([-0.01, 0.0, 0.0])) == 0.0
+    assert arc_along(points, arc, tangents, np.array([0.06, 0.07, 0.0])) == pytest.approx(arc[-1])
+
+
+def test_the_tip_position_moves_with_the_tip_not_in_steps_of_the_sampling():
+    """Advanced 0.1 mm at a time along a straight centerline sampled every 1.003 mm, the position
+    advances 0.1 mm each time (the nearest sample moved in steps of 1.003 mm)."""
+    arc = np.linspace(0.0, 0.3, 300)
+    points = np.column_stack([arc, np.zeros_like(arc), np.zeros_like(arc)])
+    tangents = np.tile([1.0, 0.0, 0.0], (len(arc), 1))
+    read = [arc_along(points, arc, tangents, np.array([x, 0.002, -0.001])) for x in np.arange(0.1, 0.11, 1e-4)]
+    assert np.diff(read) == pytest.approx(np.full(len(read) - 1, 1e-4), abs=1e-12)

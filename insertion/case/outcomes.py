@@ -218,6 +218,46 @@ def sliding_kinetic_energy(x, v, mass, speed):
 
 
 @numba.njit(cache=True)
+def arc_along(points, arc, tangents, p):
+    """Arc length (m) of the point of a sampled curve nearest to ``p`` (3,).
+
+    ``points`` (k, 3) are the curve's samples at arc lengths ``arc`` (k,), ``tangents`` (k, 3) its
+    unit tangents there. The nearest point C(s) is where (p - C(s)) . T(s) changes sign: that
+    function is evaluated at the two samples around the nearest one and its root interpolated
+    linearly between them, so the result moves continuously with ``p``, also across samples and
+    off the curve (projecting onto the chords instead jumps by d h / R at a sample, for a point d
+    off a bend of radius R sampled every h). On a circle the function is r sin(theta - theta_i)
+    for a point at radius r and angle theta: the interpolation errs by O(h^3 / R^2) whatever r.
+    Beyond the first or the last sample it returns their arc length. Compiled: the recorder
+    calls it at every sample.
+    """
+    k = points.shape[0]
+    i = 0
+    best = math.inf
+    for j in range(k):
+        d2 = (points[j, 0] - p[0]) ** 2 + (points[j, 1] - p[1]) ** 2 + (points[j, 2] - p[2]) ** 2
+        if d2 < best:
+            best = d2
+            i = j
+    j = i if _ahead(points, tangents, p, i) >= 0.0 else i - 1  # the samples j, j + 1 around the root
+    if j < 0:
+        return arc[0]
+    if j >= k - 1:
+        return arc[k - 1]
+    f0 = _ahead(points, tangents, p, j)
+    f1 = _ahead(points, tangents, p, j + 1)
+    w = min(max(f0 / (f0 - f1), 0.0), 1.0) if f0 > f1 else 0.0
+    return arc[j] + w * (arc[j + 1] - arc[j])
+
+
+@numba.njit(cache=True, inline="always")
+def _ahead(points, tangents, p, j):
+    """Coordinate of ``p`` along the tangent at sample ``j``, measured from the sample, m."""
+    return ((p[0] - points[j, 0]) * tangents[j, 0] + (p[1] - points[j, 1]) * tangents[j, 1]
+            + (p[2] - points[j, 2]) * tangents[j, 2])
+
+
+@numba.njit(cache=True)
 def principal_stretches(x, triangles, dm_inv):
     """Largest in-plane principal stretch of every triangle at positions ``x`` (n, 3), m.
 

@@ -2,7 +2,8 @@
 
 Columns (SI): time_s, depth_m (pushed distance), deformation_m (largest nodal displacement of
 the mobile colon part), max_stretch (largest in-plane principal stretch of the wall), tip_displacement_m,
-tip_arc_m (tip position along the centerline, the closest centerline point), tip_past_end_m
+tip_arc_m (tip position along the centerline: the arc length of its nearest point,
+:func:`colonsim.insertion.case.outcomes.arc_along`), tip_past_end_m
 (signed distance of the tip past the end plane of the run: >= 0 once it has passed the fixed end),
 lag_m (the scope's lag: pushed depth minus the tip's advance along the centerline), distal_force_N
 (the distal resistance holding the tip back, :mod:`colonsim.insertion.engine.tip_resistance`; 0
@@ -17,7 +18,8 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from colonsim.insertion.case.outcomes import JAM_PUSH, jammed, principal_stretches, sliding_kinetic_energy
+from colonsim.insertion.case.outcomes import (JAM_PUSH, arc_along, jammed, principal_stretches,
+                                             sliding_kinetic_energy)
 
 
 class InsertionRecorder:
@@ -41,7 +43,9 @@ class InsertionRecorder:
         self._tip0 = model.rod.x0[self._tip].copy()
         s = np.linspace(0.0, g.centerline_length, max(200, int(g.centerline_length / 1e-3)))
         self._arc = s
-        self._arc_points = np.asarray(g.centerline_points(s))
+        self._arc_points = np.ascontiguousarray(g.centerline_points(s), dtype=np.float64)
+        tangents = np.gradient(self._arc_points, s, axis=0)
+        self._arc_tangents = tangents / np.linalg.norm(tangents, axis=1)[:, None]
         # the plane whose crossing by the tip ends the run
         ends = np.clip([model.tip_end - 1e-4, model.tip_end, model.tip_end + 1e-4], 0.0, g.centerline_length)
         p = np.asarray(g.centerline_points(ends))
@@ -58,7 +62,7 @@ class InsertionRecorder:
             deformation = 0.0
         tip = scope.x[self._tip]
         depth = m.push.depth(solver.time)
-        tip_arc = float(self._arc[np.argmin(((self._arc_points - tip) ** 2).sum(axis=1))])
+        tip_arc = float(arc_along(self._arc_points, self._arc, self._arc_tangents, tip))
         row = {
             "time_s": solver.time,
             "step": solver.step,
