@@ -9,7 +9,8 @@ from __future__ import annotations
 import hashlib
 import json
 import math
-from dataclasses import asdict, dataclass
+import copy
+from dataclasses import dataclass, fields
 
 from colonsim.catalog import COLON_MODELS, colon_model
 from colonsim.input_ranges import check_input_range
@@ -225,7 +226,10 @@ class InsertionCase:
         return load_patient_centerline(self.centerline, self.centerline_smoothing_mm)
 
     def to_dict(self) -> dict:
-        return asdict(self)
+        """Every field by name; a mutable value (the drawn parameters) copied, as
+        :func:`dataclasses.asdict` gives, without its recursion through every scalar (a tenth of
+        the time: an adaptive sweep keys about a thousand candidates a round)."""
+        return {f.name: _copied(getattr(self, f.name)) for f in _FIELDS}
 
     def key(self) -> str:
         """A short hash of the inputs (identifies a run in sweeps and output folders).
@@ -249,3 +253,10 @@ class InsertionCase:
         if self.centerline is not None:
             inputs["centerline"] = "sha256:" + load_centerline_points(self.centerline).digest()
         return hashlib.sha256(json.dumps(inputs, sort_keys=True).encode()).hexdigest()[:12]
+
+
+_FIELDS = fields(InsertionCase)
+
+
+def _copied(value):
+    return value if value is None or isinstance(value, (str, int, float)) else copy.deepcopy(value)

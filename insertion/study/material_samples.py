@@ -38,6 +38,7 @@ import difflib
 import json
 import math
 from dataclasses import dataclass
+from functools import lru_cache
 from pathlib import Path
 
 import numpy as np
@@ -47,7 +48,7 @@ from colonsim.errors import ColonsimError
 from colonsim.inputs import check_input
 from colonsim.laws import OgdenLaw, get_wall_law
 from colonsim.insertion.case.case_material import case_material
-from colonsim.insertion.engine.material import read_material_document
+from colonsim.insertion.engine.material import REFERENCE_MATERIAL_PATH, read_material_document
 
 SECTION_KEYS = ("file", "population", "samples", "seed")
 MATERIAL_PARAMETERS = "material_parameters"  # the InsertionCase field a draw sets
@@ -167,12 +168,31 @@ def material_columns(case) -> dict:
     """The material columns of ``case``'s results row: its drawn parameters as JSON text ("" for
     none) and its material's mu0 and C11 in kPa (NaN if its material cannot be read)."""
     params = case.material_parameters
-    row = {MATERIAL_PARAMETERS: "" if params is None else json.dumps(params)}
+    text = "" if params is None else json.dumps(params)
+    path = Path(case.material or REFERENCE_MATERIAL_PATH).absolute()
     try:
-        material = case_material(case.material, params)
+        stat = path.stat()
+    except OSError:  # read as before: the material's own error, taken as "cannot be read" below
+        return {MATERIAL_PARAMETERS: text, **_tissue_values(case.material, text)}
+    return {MATERIAL_PARAMETERS: text, **_tissue_values_of_file(str(path), stat.st_mtime_ns, stat.st_size, text)}
+
+
+@lru_cache(maxsize=256)
+def _tissue_values_of_file(path, mtime_ns, size, parameters_text):
+    """:func:`_tissue_values`, cached per material file state (path, modification time, size) and
+    drawn parameters: the adaptive sweep reads the columns of about a thousand candidates a round,
+    which all share one or a few materials."""
+    return _tissue_values(path, parameters_text)
+
+
+def _tissue_values(path, parameters_text) -> dict:
+    """mu0 and C11 (kPa) of the material at ``path`` with the drawn parameters given as JSON text
+    ("" for none); NaN if it cannot be read."""
+    try:
+        material = case_material(path, json.loads(parameters_text) if parameters_text else None)
     except ColonsimError:  # a failed run of a material that no longer reads: no values, not an error
-        return {**row, WALL_MU0: math.nan, WALL_C11: math.nan}
-    return {**row, **{k: float(v[0]) for k, v in tissue_columns(material.law, [material.parameters]).items()}}
+        return {WALL_MU0: math.nan, WALL_C11: math.nan}
+    return {k: float(v[0]) for k, v in tissue_columns(material.law, [material.parameters]).items()}
 
 
 def _resolve(value, key, base) -> Path:

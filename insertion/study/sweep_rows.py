@@ -23,14 +23,17 @@ def input_columns() -> list:
     return [f.name for f in dataclasses.fields(InsertionCase)] + ["scope_diameter_mm", catalog.WALL_MU0, catalog.WALL_C11]
 
 
+# each field with what its column holds when the field is None: a column keeps one type, "" for
+# absent strings, NaN for absent numbers
+_ABSENT = tuple((f.name, "" if "str" in str(f.type) else math.nan) for f in dataclasses.fields(InsertionCase))
+
+
 def input_row(case) -> dict:
     """The input columns of ``case``'s results row (:func:`input_columns`)."""
     row = {}
-    for f in dataclasses.fields(InsertionCase):
-        value = getattr(case, f.name)
-        if value is None:  # a column keeps one type: "" for absent strings, NaN for absent numbers
-            value = "" if "str" in str(f.type) else math.nan
-        row[f.name] = value
+    for name, absent in _ABSENT:
+        value = getattr(case, name)
+        row[name] = absent if value is None else value
     row["scope_diameter_mm"] = round(colonoscope(case.scope).diameter * 1e3, 6)  # 11.3, not 11.299999999999999
     row.update(material_columns(case))  # drawn parameters as JSON text, mu0 and C11 in kPa
     return row

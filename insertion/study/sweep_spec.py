@@ -58,6 +58,7 @@ import math
 import sys
 from dataclasses import dataclass, field
 from pathlib import Path
+from types import MappingProxyType
 
 import numpy as np
 
@@ -102,7 +103,10 @@ class SweepSpec:
 
 def case_fields() -> dict:
     """The fields of :class:`InsertionCase` by name (taken from the dataclass, never hard-coded)."""
-    return {f.name: f for f in dataclasses.fields(InsertionCase)}
+    return _CASE_FIELDS
+
+
+_CASE_FIELDS = MappingProxyType({f.name: f for f in dataclasses.fields(InsertionCase)})  # read-only: shared
 
 
 def _unknown(key, where, known):
