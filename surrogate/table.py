@@ -117,6 +117,8 @@ def _rows(frame: pd.DataFrame, mask) -> str:
 
 def numeric_column(frame: pd.DataFrame, column, name="results table") -> pd.Series:
     """``frame[column]`` as floats (blank = NaN); a text that is no number is an error naming the row."""
+    if pd.api.types.is_numeric_dtype(frame[column]):  # numbers already (a sweep's Parquet): nothing to check
+        return frame[column].astype(float)
     values = pd.to_numeric(frame[column], errors="coerce")
     bad = values.isna() & frame[column].notna() & (frame[column].astype(str).str.strip() != "")
     if bad.any():
