@@ -1,8 +1,9 @@
 """The Matern 5/2 covariance with one length scale per input, in plain numpy.
 
 The same function as scikit-learn's ``Matern(length_scale=[...], nu=2.5)``, written out so that a
-saved surrogate predicts with numpy alone (no scikit-learn, no pickle; a query of a few rows
-takes a compiled loop of the same formulas, ``hyperposterior.few_rows_moments``) and a single
+saved surrogate predicts with numpy alone (no scikit-learn, no pickle; a query takes compiled
+loops of the same formulas, ``hyperposterior.few_rows_moments`` for a few rows and
+``hyperposterior.covariance_to_runs`` for a batch's covariances) and a single
 query is 2.4-9x faster than ``GaussianProcessRegressor.predict`` on the same model: 0.06 ms against
 0.49 ms (40 runs), 0.19 ms against 0.45 ms (500 runs); a batch of 10,000 queries takes about as
 long either way (0.8-1.6x). Measured by ``NUMBA_NUM_THREADS=1 python benchmarks/bench_surrogate.py``.
@@ -16,9 +17,8 @@ SQRT5 = np.sqrt(5.0)
 
 
 def scaled_rows(X, length_scale):
-    """The rows of ``X`` (m, d) divided by their length scales, and their squared norms (m,): the
-    half of a distance that a set of rows keeps from query to query (one per row of length scales
-    of shape (k, 1, d): (k, m, d) and (k, m))."""
+    """The rows of ``X`` (m, d) divided by their length scales, and their squared norms (m,) (one
+    per row of length scales of shape (k, 1, d): (k, m, d) and (k, m))."""
     A = np.asarray(X, dtype=float) / length_scale
     return A, np.einsum("...ij,...ij->...i", A, A)
 
