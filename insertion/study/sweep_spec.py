@@ -101,7 +101,7 @@ class SweepSpec:
                 "keys": [c.key() for c in self.cases], "toml": self.source}
 
 
-def case_fields() -> dict:
+def case_fields() -> MappingProxyType:
     """The fields of :class:`InsertionCase` by name (taken from the dataclass, never hard-coded)."""
     return _CASE_FIELDS
 
