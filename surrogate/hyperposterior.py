@@ -83,16 +83,22 @@ def covariance_to_runs(Q, X, inv_length, constant, out):
     ``constant[k]``, the formulas of :func:`few_rows_moments`. One pass over the output: numpy's
     distance and correlation took ten temporaries of its size and three quarters of a batch's time
     (2026-11-29, 10,000 queries of a 40-run model)."""
-    d = X.shape[1]
     for k in range(out.shape[0]):
         for i in range(Q.shape[0]):
             for j in range(X.shape[0]):
-                r2 = 0.0
-                for a in range(d):
-                    z = (Q[i, a] - X[j, a]) * inv_length[k, a]
-                    r2 += z * z
-                s = math.sqrt(5.0 * r2)
-                out[k, i, j] = constant[k] * (1.0 + s + s * s / 3.0) * math.exp(-s)
+                out[k, i, j] = _covariance_of_rows(Q, i, X, j, inv_length, constant, k)
+
+
+@numba.njit(cache=True, inline="always")
+def _covariance_of_rows(Q, i, X, j, inv_length, constant, k):
+    """Draw ``k``'s Matern 5/2 covariance between row ``i`` of ``Q`` and run ``j`` of ``X`` (the
+    distance from the difference of the rows)."""
+    r2 = 0.0
+    for a in range(X.shape[1]):
+        z = (Q[i, a] - X[j, a]) * inv_length[k, a]
+        r2 += z * z
+    s = math.sqrt(5.0 * r2)
+    return constant[k] * (1.0 + s + s * s / 3.0) * math.exp(-s)
 
 
 @numba.njit(cache=True)
@@ -104,7 +110,6 @@ def few_rows_moments(Q, X, inv_length, constant, alpha, L_inv, noise, with_var, 
     of total variance over the draws, as :meth:`Mixture._predict_rows` (the same numbers to
     round-off: sums in another order, the distance from the difference of the rows)."""
     draws, n = alpha.shape
-    d = X.shape[1]
     cov = np.empty(n)
     means = np.empty(draws)
     variances = np.empty(draws)
@@ -112,12 +117,7 @@ def few_rows_moments(Q, X, inv_length, constant, alpha, L_inv, noise, with_var, 
         for k in range(draws):
             mu = 0.0
             for j in range(n):
-                r2 = 0.0
-                for a in range(d):
-                    z = (Q[m, a] - X[j, a]) * inv_length[k, a]
-                    r2 += z * z
-                s = math.sqrt(5.0 * r2)
-                cov[j] = constant[k] * (1.0 + s + s * s / 3.0) * math.exp(-s)
+                cov[j] = _covariance_of_rows(Q, m, X, j, inv_length, constant, k)
                 mu += cov[j] * alpha[k, j]
             means[k] = mu
             if with_var:
