@@ -37,6 +37,23 @@ def test_straighten_relax_push_phases():
     assert continuous_push(0.2).lateral_constraint_end is None
 
 
+@pytest.mark.parametrize("straighten,depth", [(0.239, 0.68), (0.05, 0.08), (0.02, 0.021)])
+def test_pushes_too_short_to_finish_their_ramp_still_stop_at_their_depths(straighten, depth):
+    """At 0.6 m/s a 0.4 s ramp covers 12 cm speeding up and as much slowing down: a straightening
+    push shorter than 24 cm (the RSF sigmoid's 23.9 cm among them) slows down before reaching its
+    plateau, and a final push under 12 cm ends still speeding up. Each phase is timed so that the
+    profile's own depth, the integral of its speed, is the asked one."""
+    p = straighten_relax_push(straighten, depth, speed=0.6, ramp=0.4, relax=0.1)
+    straighten_phase, stop, _, push = p.phases
+    assert straighten_phase.end < 0.4  # the ramp is not finished
+    assert p.speed(stop.end) == pytest.approx(0.0, abs=1e-12)
+    assert p.depth(stop.end) == pytest.approx(straighten, rel=1e-12)
+    assert p.depth(p.duration) == pytest.approx(depth, rel=1e-12)
+    assert _integrated_depth(p, p.duration) == pytest.approx(depth, rel=1e-6)
+    short = continuous_push(0.05, speed=0.6, ramp=0.4)
+    assert short.duration < 0.4 and short.depth(short.duration) == pytest.approx(0.05, rel=1e-12)
+
+
 @pytest.mark.parametrize("args,message", [((-0.1,), "must be positive"), ((0.2, 0.0), "push speed"),
                                           ((0.2, 0.6, -1.0), "ramp")])
 def test_bad_profiles(args, message):

@@ -211,9 +211,38 @@ def _settle(phases, speed, stop_distance, settle):
                           Phase(SETTLE, end, end + ramp + settle, 0.0, ramp=ramp)]
 
 
+def _solve_time(covered, distance, ramp):
+    """The time in [0, ramp] at which ``covered(t)`` (increasing) reaches ``distance``: bisection
+    to the last bit, for the pushes too short to finish their speed ramp."""
+    lo, hi = 0.0, ramp
+    for _ in range(200):
+        mid = 0.5 * (lo + hi)
+        if mid in (lo, hi):
+            break
+        lo, hi = (mid, hi) if covered(mid) < distance else (lo, mid)
+    return hi
+
+
 def _time_to_push(distance, speed, ramp):
-    """Time for a push from rest to cover ``distance`` (the ramp covers speed * ramp / 2)."""
-    return 0.5 * ramp + distance / speed
+    """Time for a push from rest to cover ``distance``: the ramp covers speed * ramp / 2, then the
+    plateau the rest; a shorter push ends still speeding up, where the ramp's integral reaches it."""
+    if distance >= 0.5 * speed * ramp:
+        return 0.5 * ramp + distance / speed
+    return _solve_time(lambda t: speed * _transition(t, ramp)[1], distance, ramp)
+
+
+def _time_to_stop_at(distance, speed, ramp):
+    """End of a push from rest that, slowed to rest over the next ``ramp`` seconds, comes to rest
+    at ``distance``: speeding up and slowing down each cover speed * ramp / 2 after a full ramp; a
+    push too short to finish its ramp slows down from the speed it has reached."""
+    if distance >= speed * ramp:
+        return _time_to_push(distance, speed, ramp) - 0.5 * ramp
+
+    def at_rest(t):
+        reached, integral = _transition(t, ramp)
+        return speed * (integral + 0.5 * reached * ramp)
+
+    return _solve_time(at_rest, distance, ramp)
 
 
 def continuous_push(depth, speed=0.6, ramp=0.05, stop_distance=0.0, settle=0.0) -> PushProfile:
@@ -238,8 +267,7 @@ def straighten_relax_push(straighten_depth, depth, speed=0.6, ramp=0.05, relax=0
         raise ColonsimError(f"straightening depth {straighten_depth:.3g} m must lie between 0 and the total depth {depth:.3g} m")
     if not (np.isfinite(relax) and relax > 0.0):
         raise ColonsimError(f"relax time {relax!r} s must be positive (the scope must come to rest)")
-    # Slowing down from the plateau covers speed * ramp / 2, like speeding up.
-    t1 = _time_to_push(straighten_depth, speed, ramp) - 0.5 * ramp
+    t1 = _time_to_stop_at(straighten_depth, speed, ramp)
     t2 = t1 + ramp
     t3 = t2 + relax
     t4 = t3 + _time_to_push(depth - straighten_depth, speed, ramp)
