@@ -152,10 +152,12 @@ def test_a_held_push_lead_enters_the_key_only_where_a_resistance_holds_the_tip()
 
 
 def test_with_a_lead_the_push_slows_before_the_exit_and_the_tip_meets_it_at_the_held_speed():
-    # RSJ on a 6 mm mesh with the 13.3 mm scope: under 20 s; 60 mm is more than the ramp's 4.5 cm
-    # of push, so the held push's speed is reached before the tip enters the exit
+    # RSJ on a 6 mm mesh with the 13.3 mm scope, its nodes every 10 mm (the smoke spacing): about
+    # 20 s; 60 mm is more than the ramp's 4.5 cm of push, so the held push's speed is reached
+    # before the tip enters the exit
     lead_mm = 60.0
-    run = run_insertion(InsertionCase(segment="rsj", scope="sdc", element_size_mm=6.0, held_push_lead_mm=lead_mm))
+    run = run_insertion(InsertionCase(segment="rsj", scope="sdc", element_size_mm=6.0, held_push_lead_mm=lead_mm,
+                                      scope_spacing_mm=catalog.SMOKE_SCOPE_SPACING_MM))
     ts, model = run.timeseries, run.model
     case, push, exit_start = model.case, model.push, model.geometry.exit_start
     # the held push starts at the first chunk (1 mm of push) after the tip came within the lead ...

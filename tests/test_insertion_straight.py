@@ -4,14 +4,17 @@ import json
 
 import pytest
 
-from colonsim.catalog import SMOKE_PUSH_SPEED
+from colonsim.catalog import SMOKE_PUSH_SPEED, SMOKE_SCOPE_SPACING_MM
 from colonsim.cli import main
 from colonsim.insertion.case.scenario import InsertionCase, chunk_seconds, run_insertion
 
 
 @pytest.fixture(scope="module")
 def straight_run():
-    return run_insertion(InsertionCase(segment="straight", scope="pdc", element_size_mm=4.0))
+    # at the smoke push speed and scope spacing (colonsim.catalog): a centred scope sliding through
+    # a straight tube has no mechanics that a faster push would change; about 8 s on one core (30 s)
+    return run_insertion(InsertionCase(segment="straight", scope="pdc", element_size_mm=4.0,
+                                       push_speed=SMOKE_PUSH_SPEED, scope_spacing_mm=SMOKE_SCOPE_SPACING_MM))
 
 
 def test_straight_push_leaves_the_colon_undeformed(straight_run):
@@ -55,7 +58,8 @@ def test_a_sliding_scope_is_not_dragged(straight_run):
 def test_cli_insert_writes_results_and_rejects_bad_input(tmp_path, capsys):
     out = tmp_path / "ins"
     assert main(["insert", "--segment", "straight", "--scope", "utc", "--element-size", "4", "--no-progress",
-                 "--push-speed", str(SMOKE_PUSH_SPEED), "--out", str(out)]) == 0
+                 "--push-speed", str(SMOKE_PUSH_SPEED), "--scope-spacing", str(SMOKE_SCOPE_SPACING_MM),
+                 "--out", str(out)]) == 0
     summary = json.loads((out / "straight_UTC" / "summary.json").read_text())
     assert summary["mesh"]["wall_triangles"] > 0 and summary["inputs"]["scope"] == "utc"
     assert summary["inputs"]["push_speed"] == SMOKE_PUSH_SPEED

@@ -2,9 +2,12 @@
 docs/model.md, "Loading"): the final push starts from an equilibrium, and the summary says
 whether the relax came to rest, which a relax cut short says it did not.
 
-THF beta 45 with the 13.3 mm scope on a 6 mm wall mesh (about 40 s): released, the scope bent
-by the straightened transverse colon springs out and carries the floppy colon with it, a motion
-that goes on for most of a second.
+THF beta 45 with the 13.3 mm scope on a 6 mm wall mesh: released, the scope bent by the
+straightened transverse colon springs out and carries the floppy colon with it, a motion that goes
+on for most of a second. The final push after the relax is not what is checked, so 200 mm of the
+scope stay in the sheath (the default keeps 20 mm) and it ends 18 cm sooner: about 30 s a run on
+one core instead of 45. The push speed stays the default: at 0.6 m/s the straightening itself
+tears this coarse wall (largest stretch past 1.6 before the relax).
 """
 
 import pytest
@@ -13,7 +16,8 @@ from colonsim.errors import ColonsimError
 from colonsim.insertion.case.outcomes import REST_TOLERANCE, rest_drift
 from colonsim.insertion.case.scenario import InsertionCase, run_insertion
 
-COARSE = dict(segment="thf", scope="sdc", angle_deg=45.0, element_size_mm=6.0, scope_spacing_mm=10.0)
+COARSE = dict(segment="thf", scope="sdc", angle_deg=45.0, element_size_mm=6.0, scope_spacing_mm=10.0,
+              sheath_reserve_mm=200.0)
 
 
 @pytest.fixture(scope="module")
