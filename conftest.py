@@ -35,11 +35,8 @@ def pytest_sessionfinish(session, exitstatus):
 # by the number of tests, which puts a file of one long test, like the demo's, last), so starting
 # the long files first leaves the short ones to even out the two processes' ends. Only the order
 # of the run depends on this list: a file missing from it runs later, a stale entry matches nothing.
-# The second file runs no insertion (the adaptive sweep's tests run a synthetic stand-in): on a fresh
-# install the first process compiles the solver's kernels (about 55 s) while the second does other
-# work, and finds them in Numba's cache instead of compiling them again at the same time.
-LONG_FIRST = ("tests/test_demo.py", "tests/test_adaptive_sweep.py", "tests/test_insertion_rsj.py",
-              "tests/test_sweep.py", "notebooks/03_sweep_and_surrogate.ipynb",
+LONG_FIRST = ("tests/test_demo.py", "tests/test_insertion_rsj.py", "tests/test_sweep.py",
+              "tests/test_adaptive_sweep.py", "notebooks/03_sweep_and_surrogate.ipynb",
               "notebooks/02_insertion.ipynb", "tests/test_relax_until_rest.py",
               "tests/test_tissue_uncertainty.py", "tests/test_distal_resistance.py", "tests/test_verification_table.py",
               "notebooks/04_patient_anatomy.ipynb")
