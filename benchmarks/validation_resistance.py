@@ -23,7 +23,7 @@ import math
 import numpy as np
 
 from colonsim.insertion.case.insertion_case import InsertionCase
-from colonsim.insertion.case.outcomes import RINGING_LIMIT, ringing_wavelength
+from colonsim.insertion.case.outcomes import RINGING_LIMIT, ringing_at_drops, ringing_wavelength
 from colonsim.insertion.study.claims import evaluate_claims
 from colonsim.insertion.study.sweep_presets import HALF_SPEED
 from colonsim.markdown import NOT_RUN, md_table, num
@@ -147,17 +147,19 @@ def ringing_remainder(sweep, speed, half=None) -> dict:
                 rms_below.append(qs["push_force_rms_N"])
             continue
         ts = sweep.timeseries(row, ["phase", "depth_cm", "push_force_N", "contact_nodes"])
-        wavelength = None
+        wavelength, drops = None, None
         if ts is not None:
             ts = ts[ts["phase"] != "settle"]
-            w = ringing_wavelength(ts["depth_cm"].to_numpy() / 100, ts["push_force_N"].to_numpy(),
-                                   ts["contact_nodes"].to_numpy() > 0)
+            series = (ts["depth_cm"].to_numpy() / 100, ts["push_force_N"].to_numpy(),
+                      ts["contact_nodes"].to_numpy() > 0)
+            w = ringing_wavelength(*series)
             wavelength = 1e3 * w if np.isfinite(w) else None
+            drops = ringing_at_drops(*series)
         geometry = case_geometry(case)
         rings = len(geometry.nodes) // (int(geometry.end_ring.sum()) // 2)  # two end rings of equal count
         above.append({"segment": case.segment, "scope": scope_label(case), "where": _where(case),
                       "level_N": case.distal_resistance_N, "ringing_ratio": ratio, "rms_N": qs.get("push_force_rms_N"),
-                      "mean_N": qs.get("mean_push_force_N"), "wavelength_mm": wavelength,
+                      "mean_N": qs.get("mean_push_force_N"), "wavelength_mm": wavelength, "drops": drops,
                       "ring_spacing_mm": 1e3 * geometry.centerline_length / (rings - 1),
                       **ringing_bound(row, half, case)})
     return {"above": above, "rms_below_N": rms_below, "half_ran": half is not None and half.ran}
@@ -233,11 +235,14 @@ def _remainder_lines(remainder) -> list:
     columns = [("model", lambda r: r["segment"].upper()), ("scope", "scope"), ("case", "where"),
                ("level [N]", lambda r: f"{r['level_N']:g}"), ("ringing", "ringing_ratio"), ("RMS [N]", "rms_N"),
                ("mean push [N]", "mean_N"), ("repeats every [mm of push]", "wavelength_mm"),
-               ("ring spacing [mm]", "ring_spacing_mm")]
+               ("ring spacing [mm]", "ring_spacing_mm"), ("at drops", _drops_cell)]
     intro = ("The runs above the limit: the ringing in newtons (RMS about the trend; over the mean push force it is "
              "the ratio), the push distance it repeats over (the peak of its periodogram, "
              "`outcomes.ringing_wavelength`) and the wall mesh's ring spacing (docs/model.md, \"Time integration and "
-             f"damping\", what no push speed removes){scale}")
+             f"damping\", what no push speed removes){scale}. \"At drops\": the share of the squared ringing within "
+             "6 mm of push of a drop of the push force by more than 1 N within 2 mm (a loop snapping through: a step, "
+             "not an oscillation), the share of the push that lies there and the number of drops "
+             "(`outcomes.ringing_at_drops`)")
     if not remainder.get("half_ran"):
         return [intro + ":", "", md_table(remainder["above"], columns), "",
                 f"The proposed bound: {NOT_RUN}: no --ringing-half-sweep (`colonsim sweep "
@@ -254,6 +259,13 @@ def _remainder_lines(remainder) -> list:
             "columns are named):", "", md_table(remainder["above"], columns), "",
             f"By the proposed bound, {len(held)} of the {len(judged)} runs above the limit with a half-speed run count "
             f"as quasi-static ({len(remainder['above']) - len(judged)} without one).", ""]
+
+
+def _drops_cell(r):
+    d = r.get("drops")
+    if d is None or not np.isfinite(d["share"]):
+        return "-"
+    return f"{100 * d['share']:.0f} % / {100 * d['push_share']:.0f} % ({d['drops']})" if d["drops"] else "no drop"
 
 
 def _rate_cell(r):

@@ -167,10 +167,7 @@ def ringing_wavelength(depth, push_force, in_contact, window=RINGING_WINDOW, ste
     z, f = _from_first_contact(depth, push_force, in_contact)
     if z.size < 3 or z[-1] - z[0] < 2.0 * window:
         return float("nan")
-    trend, _ = depth_trend(z, f, window)
-    advancing = np.concatenate(([True], np.diff(z) > 0.0))  # a pause has one depth: keep its first sample
-    grid = np.arange(z[0], z[-1], step)
-    residual = np.interp(grid, z[advancing], (f - trend)[advancing])
+    grid, _, residual = _on_push_grid(z, f, window, step)
     residual = (residual - residual.mean()) * np.hanning(grid.size)
     power = np.abs(np.fft.rfft(residual)) ** 2
     frequency = np.fft.rfftfreq(grid.size, step)  # cycles per m of push
@@ -178,6 +175,47 @@ def ringing_wavelength(depth, push_force, in_contact, window=RINGING_WINDOW, ste
     if not shorter.any():
         return float("nan")
     return float(1.0 / frequency[shorter][np.argmax(power[shorter])])
+
+
+def _on_push_grid(z, f, window, step):
+    """The push force and its ringing about the trend over ``window`` (:func:`ringing_ratio`)
+    resampled every ``step`` of push, pauses left out: the grid (m), the force and the ringing (N)."""
+    trend, _ = depth_trend(z, f, window)
+    advancing = np.concatenate(([True], np.diff(z) > 0.0))  # a pause has one depth: keep its first sample
+    grid = np.arange(z[0], z[-1], step)
+    return grid, np.interp(grid, z[advancing], f[advancing]), np.interp(grid, z[advancing], (f - trend)[advancing])
+
+
+def ringing_at_drops(depth, push_force, in_contact, window=RINGING_WINDOW, drop_N=1.0, drop_push=2e-3,
+                     near=6e-3, step=2e-4):
+    """How much of the ringing (:func:`ringing_ratio`) sits at sudden drops of the push force.
+
+    A loop that snaps through drops the push force by newtons within a millimetre or two of push:
+    a step in a force that is otherwise a function of the depth, which the moving average turns
+    into RMS on either side of it without anything oscillating. Here a drop is the force falling
+    by more than ``drop_N`` over ``drop_push`` of push (on the force resampled every ``step``,
+    pauses left out); ``share`` is the fraction of the squared ringing within ``near`` of push of
+    a drop, ``push_share`` the fraction of the push that lies there, ``drops`` the number of
+    separate drops (closer than ``drop_push`` counts as one). An oscillation of the push force
+    about its trend gives a share near ``push_share``; ringing made of steps, a share near 1.
+
+    Returns NaN values (``drops`` 0) when under two windows of push were measured after the
+    first contact.
+    """
+    z, f = _from_first_contact(depth, push_force, in_contact)
+    if z.size < 3 or z[-1] - z[0] < 2.0 * window:
+        return {"share": float("nan"), "push_share": float("nan"), "drops": 0}
+    grid, force, residual = _on_push_grid(z, f, window, step)
+    lag = max(int(round(drop_push / step)), 1)
+    dropping = np.zeros(grid.size, dtype=bool)
+    dropping[lag:] = force[:-lag] - force[lag:] > drop_N
+    reach = int(round(near / step))
+    around = np.convolve(dropping, np.ones(2 * reach + 1), mode="same") > 0.0
+    at = np.flatnonzero(dropping)
+    drops = int(at.size > 0) + int(np.sum(np.diff(at) > lag))
+    total = float(np.sum(residual**2))
+    share = float(np.sum(residual[around] ** 2) / total) if total > 0.0 else float("nan")
+    return {"share": share, "push_share": float(np.mean(around)), "drops": drops}
 
 
 def quasi_static_fraction(kinetic, internal, ratio=0.1, floor=1e-12):
