@@ -147,13 +147,8 @@ class PushProfile:
         trial = PushProfile(before + [Phase(HELD_PUSH, t, math.inf, share * last.speed)], self.ramp)
         if goal <= trial.depth(t):
             return False
-        lo, hi = t, t + (goal - trial.depth(t)) / (share * last.speed)  # the speed stays above share * speed
-        for _ in range(200):  # depth rises monotonically: bisection to the last bit
-            mid = 0.5 * (lo + hi)
-            if mid in (lo, hi):
-                break
-            lo, hi = (mid, hi) if trial.depth(mid) < goal else (lo, mid)
-        end = hi
+        # depth rises monotonically; the speed stays above share * speed
+        end = _solve_time(trial.depth, goal, t, t + (goal - trial.depth(t)) / (share * last.speed))
         phases = before + [Phase(HELD_PUSH, t, end, share * last.speed)]
         if settle is not None:
             v = trial.speed(end)
@@ -211,10 +206,9 @@ def _settle(phases, speed, stop_distance, settle):
                           Phase(SETTLE, end, end + ramp + settle, 0.0, ramp=ramp)]
 
 
-def _solve_time(covered, distance, ramp):
-    """The time in [0, ramp] at which ``covered(t)`` (increasing) reaches ``distance``: bisection
-    to the last bit, for the pushes too short to finish their speed ramp."""
-    lo, hi = 0.0, ramp
+def _solve_time(covered, distance, lo, hi):
+    """The time in [lo, hi] at which ``covered(t)`` (increasing) reaches ``distance``: bisection
+    to the last bit (the held push's end, and the pushes too short to finish their speed ramp)."""
     for _ in range(200):
         mid = 0.5 * (lo + hi)
         if mid in (lo, hi):
@@ -228,7 +222,7 @@ def _time_to_push(distance, speed, ramp):
     plateau the rest; a shorter push ends still speeding up, where the ramp's integral reaches it."""
     if distance >= 0.5 * speed * ramp:
         return 0.5 * ramp + distance / speed
-    return _solve_time(lambda t: speed * _transition(t, ramp)[1], distance, ramp)
+    return _solve_time(lambda t: speed * _transition(t, ramp)[1], distance, 0.0, ramp)
 
 
 def _time_to_stop_at(distance, speed, ramp):
@@ -242,7 +236,7 @@ def _time_to_stop_at(distance, speed, ramp):
         reached, integral = _transition(t, ramp)
         return speed * (integral + 0.5 * reached * ramp)
 
-    return _solve_time(at_rest, distance, ramp)
+    return _solve_time(at_rest, distance, 0.0, ramp)
 
 
 def continuous_push(depth, speed=0.6, ramp=0.05, stop_distance=0.0, settle=0.0) -> PushProfile:
