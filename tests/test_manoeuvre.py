@@ -54,6 +54,25 @@ def test_pushes_too_short_to_finish_their_ramp_still_stop_at_their_depths(straig
     assert short.duration < 0.4 and short.depth(short.duration) == pytest.approx(0.05, rel=1e-12)
 
 
+@pytest.mark.parametrize("depth,stop_mm", [(0.05, 10.0), (0.10, 50.0), (0.40, 5.0)])
+def test_a_stop_distance_on_a_push_still_speeding_up_comes_to_rest_at_the_depth(depth, stop_mm):
+    """A push shorter than its speed ramp (0.6 m/s, 0.4 s: 12 cm) slows to rest over the stop
+    distance from the speed it has reached, not from the plateau it never reaches; one long enough
+    to reach its plateau before slowing keeps the closed form (0.40 m: the plateau ends
+    5 mm / 0.6 m/s before the planned end)."""
+    p = continuous_push(depth, speed=0.6, ramp=0.4, stop_distance=stop_mm * 1e-3, settle=0.5)
+    push, settle = p.phases
+    assert p.depth(p.hold_start) == pytest.approx(depth, rel=1e-12)
+    assert p.depth(settle.start) == pytest.approx(depth - stop_mm * 1e-3, rel=1e-12)
+    assert p.speed(p.hold_start + 1e-9) == 0.0 and settle.end - p.hold_start == pytest.approx(0.5)
+    assert _integrated_depth(p, p.duration) == pytest.approx(depth, rel=1e-6)
+    if depth > 0.12 + stop_mm * 1e-3:
+        assert push.end == continuous_push(depth, speed=0.6, ramp=0.4).duration - stop_mm * 1e-3 / 0.6
+    r = straighten_relax_push(0.02, 0.021 + stop_mm * 1e-3, speed=0.6, ramp=0.4, relax=0.1,
+                              stop_distance=stop_mm * 1e-3, settle=0.5)
+    assert r.depth(r.hold_start) == pytest.approx(0.021 + stop_mm * 1e-3, rel=1e-12)
+
+
 @pytest.mark.parametrize("args,message", [((-0.1,), "must be positive"), ((0.2, 0.0), "push speed"),
                                           ((0.2, 0.6, -1.0), "ramp")])
 def test_bad_profiles(args, message):

@@ -190,20 +190,33 @@ HELD_PUSH = "held push"
 RELAX = "relax"
 
 
-def _settle(phases, speed, stop_distance, settle):
+def _settle(phases, speed, ramp, stop_distance, settle):
     """``phases`` of a push ending at speed, plus a ``settle`` phase slowing to rest over
-    ``stop_distance`` (m) and holding for ``settle`` s; unchanged when both are 0."""
+    ``stop_distance`` (m) and holding for ``settle`` s; unchanged when both are 0.
+
+    The last push ends where its own depth is ``stop_distance`` short of its planned end, and the
+    slow-down starts from the speed reached there: on the plateau that is ``stop_distance / speed``
+    before its planned end; a push still speeding up is timed on the profile's depth (bisection)."""
     if settle <= 0.0 and stop_distance <= 0.0:
         return phases
     if not (np.isfinite(settle) and settle >= 0.0 and np.isfinite(stop_distance) and stop_distance >= 0.0):
         raise ColonsimError(f"settle time {settle!r} s and stop distance {stop_distance!r} m must be >= 0")
     last = phases[-1]
-    ramp = 2.0 * stop_distance / speed
-    end = last.end - stop_distance / speed  # the plateau ends where slowing down covers the stop distance
+    planned = PushProfile(phases, ramp)
+    end = last.end - stop_distance / speed  # where slowing down from the plateau covers the stop distance
+    reached = speed
+    if stop_distance > 0.0 and end < last.start + planned.ramp_of(last):
+        goal = planned.depth(last.end) - stop_distance
+        if goal <= planned.depth(last.start):
+            end = last.start
+        else:
+            end = _solve_time(planned.depth, goal, last.start, last.end)
+            reached = planned.speed(end)
     if end <= last.start:
         raise ColonsimError(f"the stop distance {stop_distance:g} m is longer than the last push; shorten it")
+    slow_down = 2.0 * stop_distance / reached
     return phases[:-1] + [Phase(last.name, last.start, end, last.speed, last.lateral_constraint, last.ramp),
-                          Phase(SETTLE, end, end + ramp + settle, 0.0, ramp=ramp)]
+                          Phase(SETTLE, end, end + slow_down + settle, 0.0, ramp=slow_down)]
 
 
 def _solve_time(covered, distance, lo, hi):
@@ -244,7 +257,7 @@ def continuous_push(depth, speed=0.6, ramp=0.05, stop_distance=0.0, settle=0.0) 
     ``stop_distance`` (m) or ``settle`` time (s), the push comes to rest at ``depth`` and holds."""
     _check(depth, speed, ramp)
     phases = [Phase("push", 0.0, _time_to_push(depth, speed, ramp), speed)]
-    return PushProfile(_settle(phases, speed, stop_distance, settle), ramp)
+    return PushProfile(_settle(phases, speed, ramp, stop_distance, settle), ramp)
 
 
 def straighten_relax_push(straighten_depth, depth, speed=0.6, ramp=0.05, relax=0.1, stop_distance=0.0,
@@ -269,7 +282,7 @@ def straighten_relax_push(straighten_depth, depth, speed=0.6, ramp=0.05, relax=0
               Phase("stop", t1, t2, 0.0, lateral_constraint=True),
               Phase(RELAX, t2, t3, 0.0),
               Phase("push", t3, t4, speed)]
-    return PushProfile(_settle(phases, speed, stop_distance, settle), ramp)
+    return PushProfile(_settle(phases, speed, ramp, stop_distance, settle), ramp)
 
 
 def _check(depth, speed, ramp):
