@@ -71,6 +71,9 @@ def test_a_stop_distance_on_a_push_still_speeding_up_comes_to_rest_at_the_depth(
     r = straighten_relax_push(0.02, 0.021 + stop_mm * 1e-3, speed=0.6, ramp=0.4, relax=0.1,
                               stop_distance=stop_mm * 1e-3, settle=0.5)
     assert r.depth(r.hold_start) == pytest.approx(0.021 + stop_mm * 1e-3, rel=1e-12)
+    assert p.slow(0.5 * push.end, 0.5)  # a held push keeps the stop distance it slows to rest over
+    assert p.depth(p.settle_start) == pytest.approx(depth - stop_mm * 1e-3, rel=1e-12)
+    assert p.depth(p.hold_start) == pytest.approx(depth, rel=1e-12)
 
 
 @pytest.mark.parametrize("args,message", [((-0.1,), "must be positive"), ((0.2, 0.0), "push speed"),

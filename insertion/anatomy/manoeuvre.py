@@ -139,7 +139,8 @@ class PushProfile:
                 or last.speed <= 0.0):
             return False
         settle = self.phases[-1] if self.phases[-1].name == SETTLE else None
-        stop_distance = 0.5 * settle.ramp * last.speed if settle is not None else 0.0
+        # the slowing to rest covers half its ramp times the speed it starts from
+        stop_distance = 0.5 * settle.ramp * self.speed(settle.start) if settle is not None else 0.0
         hold = settle.end - settle.start - settle.ramp if settle is not None else 0.0
         goal = self.depth(self.duration) - stop_distance  # where the slowing to rest begins
         before = self.phases[:-1] if settle is not None else list(self.phases)
@@ -147,8 +148,12 @@ class PushProfile:
         trial = PushProfile(before + [Phase(HELD_PUSH, t, math.inf, share * last.speed)], self.ramp)
         if goal <= trial.depth(t):
             return False
-        # depth rises monotonically; the speed stays above share * speed
-        end = _solve_time(trial.depth, goal, t, t + (goal - trial.depth(t)) / (share * last.speed))
+        # depth rises monotonically; from the plateau the speed stays above share * speed, so the
+        # bracket holds at once; a push still speeding up below it needs a wider one
+        hi = t + (goal - trial.depth(t)) / (share * last.speed)
+        while trial.depth(hi) < goal:
+            hi = t + 2.0 * (hi - t)
+        end = _solve_time(trial.depth, goal, t, hi)
         phases = before + [Phase(HELD_PUSH, t, end, share * last.speed)]
         if settle is not None:
             v = trial.speed(end)
