@@ -86,6 +86,9 @@ def main():
     (OUT / "manifest_mean.csv").write_text(
         "specimen,file,length_mm,width_mm,thickness_mm\n"
         f"mean_curve,mean_curve.csv,{LENGTH * 1e3:.1f},{WIDTH * 1e3:.1f},{mean_t * 1e3:.4f}\n")
+    (OUT / "manifest_mean_uniaxial.csv").write_text(  # the same curve as a test mode: Ogden's route
+        "specimen,file,mode,length_mm,width_mm,thickness_mm\n"
+        f"mean_curve,mean_curve.csv,uniaxial,{LENGTH * 1e3:.1f},{WIDTH * 1e3:.1f},{mean_t * 1e3:.4f}\n")
     truth["mean_curve"] = {
         "thickness_mm": mean_t * 1e3,
         "noise_rms_N": float(np.sqrt(np.mean((mean_force - mean_clean) ** 2))),

@@ -175,9 +175,7 @@ def test_a_material_file_is_written_when_mu0_is_not_identified(tmp_path, capsys)
     """Three Ogden terms on the colon strips' mean curve (uniaxial, to stretch 1.6) leave one
     combination of the parameters unfixed, and mu0 has a share in it: its sd is infinite, written
     as null (not identified), where the material file was refused before ("mu0_sd_Pa is inf")."""
-    manifest = tmp_path / "colon_uniaxial.csv"
-    manifest.write_text("specimen,file,mode,length_mm,width_mm,thickness_mm\n"
-                        f"mean_curve,{BUNDLED_MANIFEST.parent / 'mean_curve.csv'},uniaxial,100,25,1.8708\n")
+    manifest = BUNDLED_MANIFEST.parent / "manifest_mean_uniaxial.csv"  # the README's and docs' example
     assert main(["calibrate", "--manifest", str(manifest), "--law", "ogden_3", "--analytic", "--no-progress",
                  "--out", str(tmp_path / "og")]) == 0
     doc = json.loads((tmp_path / "og" / "material.json").read_text())
