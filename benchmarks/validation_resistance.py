@@ -45,6 +45,13 @@ def _number(row, column):
     return float(value) if value is not None and np.isfinite(value) else None
 
 
+def _ended(row):
+    """Why a run ended, and whether its tip ended turned back (docs/model.md, "Outputs"; rows of
+    sweeps made before 2026-11-29 do not record it)."""
+    back = row.get("tip_turned_back_cm")
+    return row["ended_by"] + ("" if back is None else f", tip turned back from {back:.1f} cm")
+
+
 def _where(case):
     if case.segment == "rsj":
         return f"D {case.diameter_mm:g} mm"
@@ -72,7 +79,7 @@ def resistance_section(sweep, half=None) -> dict:
                      "level_N": case.distal_resistance_N, **{c: _number(row, c) for c in (
                          "final_deformation_cm", "max_deformation_cm", "max_lag_cm", "final_lag_cm",
                          "peak_contact_force_N", "peak_push_force_N", "point_A_cm", "point_B_cm", "point_C_cm",
-                         "ringing_ratio")},
+                         "ringing_ratio", "tip_turned_back_cm")},
                      "ended_by": str(row.get("ended_by", ""))})
     claims = claims_per_level(sweep, speed)
     return {"ran": True, "rows": rows, "missing": missing, "differences": _differences(rows),
@@ -301,7 +308,7 @@ def markdown(section) -> list:
                                   ("final [cm]", "final_deformation_cm"), ("max [cm]", "max_deformation_cm"),
                                   ("lag max / final [cm]", lambda r: f"{num(r['max_lag_cm'])} / {num(r['final_lag_cm'])}"),
                                   ("peak contact [N]", "peak_contact_force_N"), ("peak push [N]", "peak_push_force_N"),
-                                  ("ended by", "ended_by"), ("ringing", "ringing_ratio")]), ""]
+                                  ("ended by", _ended), ("ringing", "ringing_ratio")]), ""]
     rsj = section["rsj"]
     if rsj:
         lines += ["RSJ points per level (C > A: the loop behind a held tip grows):", "",

@@ -177,23 +177,6 @@ def colon_model(name) -> ColonModel:
                             f"{', '.join(COLON_MODELS)}") from None
 
 
-def segment_help() -> str:
-    """Help text of ``--segment``: each model with its title."""
-    return ", ".join(f"{m.name} ({m.title})" for m in COLON_MODELS.values())
-
-
-def angle_help() -> str:
-    """Help text of ``--angle``: what the angle means in which model, and its limits."""
-    parts = []
-    for symbol in (ALPHA, BETA):
-        models = [m for m in COLON_MODELS.values() if m.angle == symbol]
-        if models:
-            low, high = models[0].angle_limits_deg
-            parts.append(f"{symbol} of {', '.join(m.name for m in models)} ({low:g}-{high:g} deg)")
-    ignored = [m.name for m in COLON_MODELS.values() if m.angle == NO_ANGLE]
-    return "; ".join(parts) + (f"; ignored by {', '.join(ignored)}" if ignored else "")
-
-
 # -- named scopes -------------------------------------------------------------------------------
 
 SCOPE_YOUNGS_MODULUS = 16e6  # Pa, from the flexural rigidity of a 3-point bending test
@@ -283,13 +266,6 @@ def scope_role(diameter_mm):
         if any(abs(diameter_mm - d * 1e3) < 0.05 for d in (scope.diameter, scope.meshed_diameter)):
             return name
     return None
-
-
-def scope_help() -> str:
-    """Help text of ``--scope``: the named scopes with their diameters, or a diameter in mm."""
-    low, high = SCOPE_DIAMETER_RANGE
-    named = ", ".join(f"{s.name} ({s.title}, {s.diameter * 1e3:g} mm)" for s in NAMED_SCOPES.values())
-    return f"{named}, or an outer diameter in mm ({low * 1e3:g}-{high * 1e3:g})"
 
 
 # -- results-table columns ----------------------------------------------------------------------
@@ -415,6 +391,9 @@ COLUMNS = {c.name: c for c in (
     Column("max_lag_cm", _O, "cm", "largest lag of the scope: pushed depth minus the tip's advance along the "
                                    "centerline (a proxy of the buckled length)", TARGET, "maximum scope lag [cm]"),
     Column("final_lag_cm", _O, "cm", "the scope's lag at the end of the run", TARGET, "final scope lag [cm]"),
+    Column("tip_turned_back_cm", _O, "cm", "pushed depth from which the tip points back against the lumen (its last "
+                                           "segment more than 90 deg from the lumen's direction) to the end of the "
+                                           "run; empty if it does not at the end (docs/model.md, \"Distal resistance\")"),
     Column("ended_by", _O, "", "why the run ended: tip_past_end, far_end, length_used, wall_stretch or jam "
                                "(docs/model.md, \"Loading\")"),
     Column("end_depth_cm", _O, "cm", "pushed depth where the run ended"),

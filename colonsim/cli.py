@@ -14,7 +14,7 @@ import threading
 import warnings
 from pathlib import Path
 
-from colonsim import catalog, cli_material, cli_surrogate, cli_sweep
+from colonsim import catalog, cli_material, cli_surrogate, cli_sweep, options
 from colonsim.errors import ColonsimError, ColonsimWarning
 from colonsim.files import os_failure
 from colonsim.input_ranges import check_input_range
@@ -116,8 +116,8 @@ def _add_insert(sub):
                                    "deformation, contact and push forces, tip motion and energies. Writes "
                                    "timeseries.csv, summary.json and insertion.png per scope, a comparison table "
                                    "and figure, and optional VTU files for ParaView.")
-    p.add_argument("--segment", default=None, help=f"colon model (default rsj): {catalog.segment_help()}")
-    p.add_argument("--scope", nargs="+", default=["sdc"], help=f"{catalog.scope_help()}; several allowed (default sdc)")
+    p.add_argument("--segment", default=None, help=f"colon model (default rsj): {options.segment_help()}")
+    p.add_argument("--scope", nargs="+", default=["sdc"], help=f"{options.scope_help()}; several allowed (default sdc)")
     p.add_argument("--centerline", type=Path,
                    help="a patient's centerline CSV (x_mm, y_mm, z_mm, label fixed/mobile, optional diameter_mm "
                         "and name; docs/model.md); implies --segment patient")
@@ -127,7 +127,7 @@ def _add_insert(sub):
     p.add_argument("--diameter", type=finite_float, default=None,
                    help="colon inner diameter, mm (default 36; with --centerline, the median of the file's "
                         "diameter_mm column when it has one)")
-    p.add_argument("--angle", type=finite_float, default=0.0, help=f"degrees (default 0): {catalog.angle_help()}")
+    p.add_argument("--angle", type=finite_float, default=0.0, help=f"degrees (default 0): {options.angle_help()}")
     p.add_argument("--friction", type=finite_float, default=0.0, help="Coulomb friction scope/wall (default 0)")
     p.add_argument("--wall-thickness", type=finite_float, default=2.0, help="colon wall thickness, mm (default 2, an assumption)")
     p.add_argument("--element-size", type=finite_float, default=InsertionCase.element_size_mm,

@@ -11,7 +11,7 @@ import argparse
 import json
 from pathlib import Path
 
-from colonsim import catalog
+from colonsim import catalog, options
 from colonsim.errors import ColonsimError
 from colonsim.options import bounded_int, finite_float, output_file, seed, worker_count
 
@@ -40,8 +40,8 @@ def _cv(text):
 
 def _patient_options(p, scope_diameter=True):
     g = p.add_argument_group("patient: presets (docs/surrogate.md) and raw parameters (raw ones win)")
-    g.add_argument("--segment", help=catalog.segment_help())
-    g.add_argument("--scope", nargs="+", help=f"{catalog.scope_help()} (default: the scopes of the sweep)")
+    g.add_argument("--segment", help=options.segment_help())
+    g.add_argument("--scope", nargs="+", help=f"{options.scope_help()} (default: the scopes of the sweep)")
     g.add_argument("--sex", help="male (0 deg), intermediate (30 deg), female (45 deg): alpha in RSF, beta in THF")
     g.add_argument("--age", help="young (mu 0), middle (0.05), older (0.1, diverticular disease)")
     g.add_argument("--region", help="european (23 mm), african (36 mm): colon diameter in RSJ")
@@ -49,7 +49,7 @@ def _patient_options(p, scope_diameter=True):
     if scope_diameter:
         g.add_argument("--scope-diameter", type=finite_float, help="scope outer diameter, mm (instead of --scope)")
     g.add_argument("--diameter", type=finite_float, help="colon inner diameter, mm")
-    g.add_argument("--angle", type=finite_float, help=f"degrees: {catalog.angle_help()}")
+    g.add_argument("--angle", type=finite_float, help=f"degrees: {options.angle_help()}")
     g.add_argument("--friction", type=finite_float, help="Coulomb friction scope/wall")
     g.add_argument("--wall-thickness", type=finite_float, help="colon wall thickness, mm")
     g.add_argument("--distal-resistance", type=finite_float,

@@ -1,4 +1,5 @@
-"""Value types of the command-line options: numbers that must be finite, outputs checked at once.
+"""Value types of the command-line options (numbers that must be finite, outputs checked at once)
+and the help texts that list the catalog's colon models, angles and scopes.
 
 Each turns a bad value into an argparse error (one line, exit code 2, see
 :class:`colonsim.cli.OneLineParser`) while the options are read, so that nothing starts on input
@@ -10,6 +11,7 @@ from __future__ import annotations
 import argparse
 import math
 
+from colonsim import catalog
 from colonsim.errors import ColonsimError
 from colonsim.files import check_output_file, check_output_folder
 from colonsim.limits import SEED_RANGE, WORKERS_PER_CORE, max_workers
@@ -89,3 +91,27 @@ def output_file(*suffixes):
 
     file_type.__name__ = "output file"
     return file_type
+
+
+def segment_help() -> str:
+    """Help text of ``--segment``: each model with its title."""
+    return ", ".join(f"{m.name} ({m.title})" for m in catalog.COLON_MODELS.values())
+
+
+def angle_help() -> str:
+    """Help text of ``--angle``: what the angle means in which model, and its limits."""
+    parts = []
+    for symbol in (catalog.ALPHA, catalog.BETA):
+        models = [m for m in catalog.COLON_MODELS.values() if m.angle == symbol]
+        if models:
+            low, high = models[0].angle_limits_deg
+            parts.append(f"{symbol} of {', '.join(m.name for m in models)} ({low:g}-{high:g} deg)")
+    ignored = [m.name for m in catalog.COLON_MODELS.values() if m.angle == catalog.NO_ANGLE]
+    return "; ".join(parts) + (f"; ignored by {', '.join(ignored)}" if ignored else "")
+
+
+def scope_help() -> str:
+    """Help text of ``--scope``: the named scopes with their diameters, or a diameter in mm."""
+    low, high = catalog.SCOPE_DIAMETER_RANGE
+    named = ", ".join(f"{s.name} ({s.title}, {s.diameter * 1e3:g} mm)" for s in catalog.NAMED_SCOPES.values())
+    return f"{named}, or an outer diameter in mm ({low * 1e3:g}-{high * 1e3:g})"

@@ -80,7 +80,7 @@ def summary_of(case):
 def standin_runner(case):
     """SYNTHETIC run: no simulation, the known function as its outcome."""
     columns = ["time_s", "depth_m", "deformation_m", "max_stretch", "tip_displacement_m", "tip_arc_m",
-               "tip_past_end_m", "lag_m", "distal_force_N", "contact_force_N", "push_force_N", "contact_nodes",
+               "tip_past_end_m", "lag_m", "tip_heading_deg", "distal_force_N", "contact_force_N", "push_force_N", "contact_nodes",
                "kinetic_colon_J",
                "internal_colon_J", "kinetic_scope_J", "kinetic_scope_sliding_J", "internal_scope_J",
                "contact_energy_J", "dt_s", "step"]

@@ -10,7 +10,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from colonsim import catalog
+from colonsim import catalog, options
 from colonsim.catalog import COLON_MODELS, COLUMNS, NAMED_SCOPES, ColonModel, NamedScope
 from colonsim.data import data_path
 from colonsim.insertion.anatomy.patient_centerline import load_patient_centerline
@@ -82,7 +82,7 @@ def test_colon_model_facts_reach_sweep_and_surrogate():
     for name, model in COLON_MODELS.items():
         assert ("angle_deg" in patient_inputs(name, sex="female")) == model.surrogate_angle
     for name in names:
-        assert name in catalog.segment_help()
+        assert name in options.segment_help()
 
 
 def test_a_new_colon_model_is_one_entry(monkeypatch, tmp_path):
@@ -98,7 +98,7 @@ def test_a_new_colon_model_is_one_entry(monkeypatch, tmp_path):
     spec = parse_sweep('[grid]\nsegment = ["tube", "straight"]\nscope = ["utc", "sdc"]')
     assert sorted({c.segment for c in spec.cases}) == ["straight", "tube"] and len(spec.cases) == 4
     assert set(check_results(_table(["tube", "rsj"]))["segment"]) == {"tube", "rsj"}
-    assert "tube" in catalog.segment_help() and "tube" in catalog.angle_help()
+    assert "tube" in options.segment_help() and "tube" in options.angle_help()
 
 
 def test_a_new_straightened_model_gets_the_manoeuvre_and_its_rules(monkeypatch):
@@ -112,7 +112,7 @@ def test_a_new_straightened_model_gets_the_manoeuvre_and_its_rules(monkeypatch):
     assert built.geometry.exit_start == pytest.approx(reference.geometry.exit_start, abs=1e-12)
     assert built.geometry.centerline_length == pytest.approx(reference.geometry.centerline_length + 0.05, abs=1e-9)
     assert all(np.allclose(a[0], b[0]) for a, b in zip(built.geometry.mobile_axes, reference.geometry.mobile_axes))
-    assert "rsf-long" in catalog.angle_help()
+    assert "rsf-long" in options.angle_help()
     with pytest.raises(ColonsimError, match="outside 0-60 deg"):
         colon_geometry("rsf-long", 0.036, 70.0, COARSE_MM * 1e-3, 2e-3)
 
@@ -132,7 +132,7 @@ def test_a_new_named_scope_is_one_entry(monkeypatch, tmp_path):
     assert scope_diameter_mm("xtc") == 7.0 and scope_diameter_mm("Xtc") == 7.0
     assert check_results(_table(["rsj"], scopes=("xtc", "sdc")))["scope_diameter_mm"].tolist() == [7.0, 12.8]
     assert catalog.scope_role(7.2) == "xtc" and catalog.meshed_diameters()["xtc"] == 7.2e-3
-    assert "xtc" in catalog.scope_help() and "xtc" in catalog.small_caliber_scopes()
+    assert "xtc" in options.scope_help() and "xtc" in catalog.small_caliber_scopes()
 
 
 @pytest.mark.parametrize("spec,expected", [("utc", ("UTC", 9.2e-3)), (" SDC ", ("SDC", 12.8e-3)),

@@ -42,6 +42,8 @@ def test_the_push_reaches_the_far_end_and_rests(straight_run):
     assert ts["kinetic_scope_J"].iloc[-1] < 1e-9 and ts["kinetic_colon_J"].iloc[-1] < 1e-9
     # the tip follows the pushed end: a stiff rod in a sheath, no axial buckling
     assert 0.20 + ts["tip_past_end_m"].iloc[-1] == pytest.approx(ts["depth_m"].iloc[-1], abs=0.002)
+    # and points on along the tube (a straight scope in a straight tube: heading 0 deg)
+    assert ts["tip_heading_deg"].max() < 1.0 and straight_run.summary["tip_turned_back_cm"] is None
 
 
 def test_a_sliding_scope_is_not_dragged(straight_run):

@@ -5,7 +5,8 @@ import pytest
 
 from colonsim.insertion.case.outcomes import (JAM_FORCE, JAM_PROGRESS, JAM_PUSH, arc_along, characteristic_points, jammed,
                                               principal_stretches, quasi_static_fraction, ringing_wavelength,
-                                              sliding_kinetic_energy)
+                                              sliding_kinetic_energy, tip_heading, turned_back)
+from colonsim.insertion.case.results import distal_words
 
 
 def rsj_like(noise=0.0, seed=0):
@@ -198,3 +199,40 @@ def test_the_tip_position_moves_with_the_tip_not_in_steps_of_the_sampling():
     tangents = np.tile([1.0, 0.0, 0.0], (len(arc), 1))
     read = [arc_along(points, arc, tangents, np.array([x, 0.002, -0.001])) for x in np.arange(0.1, 0.11, 1e-4)]
     assert np.diff(read) == pytest.approx(np.full(len(read) - 1, 1e-4), abs=1e-12)
+
+
+@pytest.mark.parametrize("turn_deg", [0.0, 30.0, 89.0, 91.0, 150.0, 180.0])
+def test_the_tip_heading_is_the_angle_of_its_last_segment_to_the_lumen(turn_deg):
+    """A quarter circle of radius 0.1 m as the centerline, the tip at its middle (45 deg round), its
+    last segment turned by ``turn_deg`` from the tangent there, in the bend's plane: the heading
+    is that angle whatever the scope's other nodes do."""
+    arc = np.linspace(0.0, 0.05 * np.pi, 2001)
+    phi = arc / 0.1
+    tangents = np.stack([-np.sin(phi), np.cos(phi), np.zeros_like(phi)], axis=1)
+    here = np.pi / 4
+    t = np.array([-np.sin(here), np.cos(here), 0.0])
+    n = np.array([np.cos(here), np.sin(here), 0.0])
+    a = np.radians(turn_deg)
+    tip = 0.1 * n
+    scope = np.array([[5.0, 5.0, 5.0], tip - 0.005 * (np.cos(a) * t + np.sin(a) * n), tip])
+    assert tip_heading(scope, 2, arc, tangents, 0.1 * here) == pytest.approx(turn_deg, abs=0.1)
+
+
+def test_a_tip_turned_back_is_dated_from_the_push_it_stayed_so():
+    depth = np.linspace(0.0, 0.6, 61)
+    assert turned_back(depth, np.full(61, 30.0)) is None  # never
+    heading = np.where(depth > 0.4, 170.0, 40.0)
+    assert turned_back(depth, heading) == pytest.approx(0.41)
+    heading[50] = 60.0  # back on course for one sample: dated from after it
+    assert turned_back(depth, heading) == pytest.approx(0.51)
+    heading[-1] = 80.0  # on course again at the end: not turned back
+    assert turned_back(depth, heading) is None
+    assert turned_back(depth, np.full(61, 120.0)) == 0.0 and turned_back([], []) is None
+
+
+def test_the_command_line_says_when_the_tip_ended_turned_back():
+    summary = {"max_lag_cm": 25.3, "final_lag_cm": 25.3, "tip_turned_back_cm": None,
+               "distal_resistance": {"acting": True, "resistance_N": 20.0, "final_force_N": 0.0}}
+    assert "TURNED BACK" not in distal_words(summary)
+    assert "TURNED BACK at 59.4 cm" in distal_words({**summary, "tip_turned_back_cm": 59.4})
+    assert "TURNED BACK" not in distal_words({k: v for k, v in summary.items() if k != "tip_turned_back_cm"})

@@ -295,6 +295,31 @@ def _ahead(points, tangents, p, j):
             + (p[2] - points[j, 2]) * tangents[j, 2])
 
 
+TURNED_BACK_DEG = 90.0  # deg: a tip heading more than this away from the lumen's direction points back
+
+
+def tip_heading(scope_x, tip, arc, tangents, tip_arc):
+    """Angle (deg) between the scope's last segment (from the node before ``tip`` to it) and the
+    lumen's direction where the tip is (``tip_arc`` m along the centerline, whose unit
+    ``tangents`` are sampled at arc lengths ``arc``): 0 on along the lumen, 180 turned back."""
+    d = scope_x[tip] - scope_x[tip - 1]
+    k = min(int(np.searchsorted(arc, tip_arc)), len(arc) - 1)
+    cosine = float(np.dot(d, tangents[k])) / float(np.linalg.norm(d))
+    return math.degrees(math.acos(min(1.0, max(-1.0, cosine))))
+
+
+def turned_back(depth, heading, limit=TURNED_BACK_DEG):
+    """Pushed depth (m) from which the tip points back against the lumen (``heading`` above
+    ``limit`` deg) through to the last sample; None when it does not at the last sample. A tip
+    turned back no longer advances against a distal resistance: what is pushed after it goes into
+    a fold, not into the colon (docs/model.md, "Distal resistance")."""
+    heading = np.asarray(heading, dtype=float)
+    if heading.size == 0 or not heading[-1] > limit:
+        return None
+    forward = np.flatnonzero(~(heading > limit))
+    return float(np.asarray(depth, dtype=float)[forward[-1] + 1 if forward.size else 0])
+
+
 @numba.njit(cache=True)
 def principal_stretches(x, triangles, dm_inv):
     """Largest in-plane principal stretch of every triangle at positions ``x`` (n, 3), m.

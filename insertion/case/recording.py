@@ -5,7 +5,9 @@ the mobile colon part), max_stretch (largest in-plane principal stretch of the w
 tip_arc_m (tip position along the centerline: the arc length of its nearest point,
 :func:`colonsim.insertion.case.outcomes.arc_along`), tip_past_end_m
 (signed distance of the tip past the end plane of the run: >= 0 once it has passed the fixed end),
-lag_m (the scope's lag: pushed depth minus the tip's advance along the centerline), distal_force_N
+lag_m (the scope's lag: pushed depth minus the tip's advance along the centerline), tip_heading_deg
+(the angle between the scope's last segment and the lumen's direction at the tip: 0 on along it,
+above 90 turned back, :func:`colonsim.insertion.case.outcomes.tip_heading`), distal_force_N
 (the distal resistance holding the tip back, :mod:`colonsim.insertion.engine.tip_resistance`; 0
 without one), contact_force_N (sum of normal contact forces),
 push_force_N (drive reaction along the sheath axis), contact_nodes, kinetic/internal energy
@@ -19,7 +21,7 @@ import numpy as np
 import pandas as pd
 
 from colonsim.insertion.case.outcomes import (JAM_PUSH, arc_along, jammed, principal_stretches,
-                                             sliding_kinetic_energy)
+                                             sliding_kinetic_energy, tip_heading)
 
 
 class InsertionRecorder:
@@ -74,6 +76,7 @@ class InsertionRecorder:
             "tip_arc_m": tip_arc,
             "tip_past_end_m": float(np.dot(tip - self._end_point, self._end_axis)),
             "lag_m": depth - tip_arc,
+            "tip_heading_deg": tip_heading(scope.x, self._tip, self._arc, self._arc_tangents, tip_arc),
             "distal_force_N": float(m.resistance.force) if m.resistance is not None else 0.0,
             "contact_force_N": float(m.contact.normal_force),
             "contact_nodes": int(m.contact.n_active),

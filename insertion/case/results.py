@@ -29,6 +29,7 @@ def user_units(ts: pd.DataFrame) -> pd.DataFrame:
                         "deformation_cm": ts["deformation_m"] * 100, "max_wall_stretch": ts["max_stretch"],
                         "tip_displacement_cm": ts["tip_displacement_m"] * 100, "tip_arc_cm": ts["tip_arc_m"] * 100,
                         "tip_past_end_cm": ts["tip_past_end_m"] * 100, "lag_cm": ts["lag_m"] * 100,
+                        "tip_heading_deg": ts["tip_heading_deg"],
                         "distal_force_N": ts["distal_force_N"],
                         "contact_force_N": ts["contact_force_N"], "push_force_N": ts["push_force_N"],
                         "contact_nodes": ts["contact_nodes"]})
@@ -76,6 +77,10 @@ def distal_words(summary: dict) -> str:
     """The distal resistance and the scope's lag of a summary, for the command line."""
     d = summary["distal_resistance"]
     lag = f"scope lag max {summary['max_lag_cm']:.1f} cm, final {summary['final_lag_cm']:.1f} cm"
+    back = summary.get("tip_turned_back_cm")
+    if back is not None:
+        lag += (f"; the tip TURNED BACK at {back:.1f} cm of push and stayed so: the final deformation and lag "
+                "describe a fold of the scope, not a loop behind a held tip")
     if not d["acting"]:
         return f"no distal resistance; {lag}"
     return f"distal resistance {d['resistance_N']:g} N (holding {d['final_force_N']:.1f} N at the end); {lag}"
@@ -94,6 +99,7 @@ def comparison_table(results) -> pd.DataFrame:
                            "peak_push_force_N": r.summary["peak_push_force_N"],
                            "max_wall_stretch": r.summary["max_wall_stretch"],
                            "max_lag_cm": r.summary["max_lag_cm"], "final_lag_cm": r.summary["final_lag_cm"],
+                           "tip_turned_back_cm": r.summary.get("tip_turned_back_cm"),
                            "ringing_ratio": r.summary["quasi_static"]["ringing_ratio"],
                            "quasi_static": r.summary["quasi_static"]["holds"],
                            "came_to_rest": r.summary["at_rest"]["came_to_rest"],

@@ -8,7 +8,8 @@ from colonsim.catalog import colon_model
 from colonsim.insertion.anatomy.manoeuvre import SETTLE
 from colonsim.insertion.case.outcomes import (JAM_FORCE, JAM_PROGRESS, JAM_PUSH, PEAK_WINDOW, REST_TOLERANCE,
                                               REST_WINDOW, RINGING_LIMIT, RINGING_WINDOW, characteristic_points,
-                                              peak_trend, quasi_static_fraction, rest_drift, ringing_ratio)
+                                              peak_trend, quasi_static_fraction, rest_drift, ringing_ratio,
+                                              turned_back)
 from colonsim.insertion.engine.material import REFERENCE_MATERIAL_PATH
 from colonsim.provenance import code_version
 
@@ -113,6 +114,9 @@ def summarize(model, ts, wall_s, build_s) -> dict:
         "final_tip_arc_cm": float(ts["tip_arc_m"].iloc[-1] * 100),
         "max_lag_cm": float(ts["lag_m"].max() * 100),
         "final_lag_cm": float(ts["lag_m"].iloc[-1] * 100),
+        "tip_turned_back_cm": (None if (back := turned_back(ts["depth_m"], ts["tip_heading_deg"])) is None
+                               else back * 100),
+        "max_tip_heading_deg": float(ts["tip_heading_deg"].max()),
         "distal_resistance": {"resistance_N": model.case.distal_resistance_N,
                               "exit_start_cm": None if g.exit_start is None else g.exit_start * 100,
                               "acting": model.resistance is not None,
