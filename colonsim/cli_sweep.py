@@ -31,6 +31,9 @@ def add_parser(sub):
                                                     "it holds one sweep, which a rerun resumes")
     p.add_argument("--retry-failed", action="store_true", help="run again the cases recorded as failed")
     p.add_argument("--dry-run", action="store_true", help="check and list the cases and which are done, run nothing")
+    p.add_argument("--reuse", nargs="+", type=Path, metavar="FOLDER", default=(),
+                   help="other sweep folders: their finished runs of the same cases (same inputs) are copied in, "
+                        "not run again")
     p.add_argument("--max-steps", type=positive_int, default=DEFAULT_MAX_STEPS,
                    help=f"refuse the sweep if a run needs more time steps (default {DEFAULT_MAX_STEPS:,}; one run "
                         "per material file is estimated: a material in the wrong unit makes every run long)")
@@ -64,6 +67,9 @@ def _adaptive_settings(args, workers):
         if given:
             raise ColonsimError(f"{', '.join(given)} belong(s) to adaptive sweeps; add --adaptive or drop them")
         return None
+    if args.reuse:
+        raise ColonsimError("--reuse is for sweeps of given cases; an adaptive sweep chooses its runs as results "
+                            "come in: drop --reuse or --adaptive")
     if args.dry_run:
         raise ColonsimError("--dry-run cannot list an adaptive sweep's runs (they are chosen as results come in); "
                             "drop --adaptive to list the first round")
@@ -106,7 +112,7 @@ def cmd_sweep(args):
         check_scheduler(args.scheduler)
     from colonsim.insertion.case.run_budget import check_sweep_budget
     from colonsim.insertion.study.adaptive_sweep import ROUNDS
-    from colonsim.insertion.study.sweep import SweepStore, describe_cases, run_sweep
+    from colonsim.insertion.study.sweep import SweepStore, describe_cases, reusable_runs, run_sweep
     from colonsim.insertion.study.sweep_outcomes import dask_distributed
     from colonsim.insertion.study.sweep_spec import load_sweep
 
@@ -128,14 +134,16 @@ def cmd_sweep(args):
         store.load()
         store.check_same_sweep([c.key() for c in spec.cases], spec.source)
         done = store.finished(args.retry_failed)
+        pending = {c.key() for c in spec.cases} - done
+        reused = len(reusable_runs(args.reuse, pending, out)) if args.reuse else 0
         print(describe_cases(spec.cases))
-        todo = sum(c.key() not in done for c in spec.cases)
-        print(f"sweep {spec.name}: {len(spec.cases)} runs, {len(spec.cases) - todo} already in {out}/, "
-              f"{todo} to run on {where}")
+        print(f"sweep {spec.name}: {len(spec.cases)} runs, {len(spec.cases) - len(pending)} already in {out}/, "
+              + (f"{reused} to copy from {', '.join(map(str, args.reuse))}, " if args.reuse else "")
+              + f"{len(pending) - reused} to run on {where}")
         return
     print(f"sweep {spec.name}: {len(spec.cases)} runs on {where} -> {out}/", flush=True)
     report = run_sweep(spec.cases, out, workers=workers, scheduler=args.scheduler, retry_failed=args.retry_failed,
-                       spec=spec, progress=not args.no_progress, max_steps=args.max_steps)
+                       spec=spec, progress=not args.no_progress, max_steps=args.max_steps, reuse=args.reuse)
     rate = "" if report.ran == 0 else f" ({report.runs_per_hour:.0f} runs/hour)"
     print(f"{report.skipped} already finished (skipped), {report.ran} run in {report.wall_time_s:.1f} s{rate}: "
           f"{report.ok} ok, {report.failed} failed")

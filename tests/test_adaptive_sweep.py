@@ -276,6 +276,39 @@ def test_the_loop_stops_at_the_budget_resumes_without_repeating_and_records_roun
         run_adaptive_sweep(s, out, AdaptiveSettings(budget=14, target="final_deformation_cm"), progress=False)
 
 
+def test_a_sweep_reuses_the_finished_runs_of_the_same_cases_from_other_folders(tmp_path):
+    """Runs whose key (every input) another sweep folder holds are copied in with their run folder
+    and row, not run again; the others run. One-line errors for a folder that is not a sweep's
+    and for the sweep's own folder; an adaptive sweep refuses --reuse."""
+    first, second = spec(samples=4).cases, spec(samples=3, seed=8).cases
+    done = run_sweep(first, tmp_path / "a", workers=1, runner=standin_runner, progress=False)
+    assert done.ran == 4
+    said = []
+    cases = first[:3] + second[:2]
+    report = run_sweep(cases, tmp_path / "b", workers=1, runner=standin_runner, progress=False,
+                       reuse=[tmp_path / "a"], log=said.append)
+    assert (report.ran, report.skipped) == (2, 3) and "3 run(s) of the same cases taken from" in said[-1]
+    source = pd.read_parquet(tmp_path / "a" / "results.parquet").set_index("key")
+    table = report.table.set_index("key")
+    for case in first[:3]:  # the row as it was, its time stamp and code version included
+        key = case.key()
+        assert table.loc[key, "finished_at"] == source.loc[key, "finished_at"]
+        assert table.loc[key, "final_deformation_cm"] == source.loc[key, "final_deformation_cm"]
+        assert (tmp_path / "b" / table.loc[key, "timeseries_path"]).is_file()
+        assert (tmp_path / "b" / "runs" / key / "summary.json").read_bytes() == (
+            tmp_path / "a" / "runs" / key / "summary.json").read_bytes()
+    assert set(table.index) == {c.key() for c in cases} and (table["status"] == "ok").all()
+    again = run_sweep(cases, tmp_path / "b", workers=1, runner=standin_runner, progress=False,
+                      reuse=[tmp_path / "a"], log=said.append)
+    assert again.ran == 0 and again.skipped == 5  # resumed: nothing left to take or run
+    with pytest.raises(ColonsimError, match="no results.parquet there"):
+        run_sweep(cases, tmp_path / "c", runner=standin_runner, progress=False, reuse=[tmp_path / "nowhere"])
+    with pytest.raises(ColonsimError, match="this sweep's own folder"):
+        run_sweep(cases, tmp_path / "b", runner=standin_runner, progress=False, reuse=[tmp_path / "b"])
+    assert main(["sweep", "--preset", "smoke", "--adaptive", "--budget", "4", "--reuse", str(tmp_path / "a"),
+                 "--out", str(tmp_path / "d")]) == 2
+
+
 def test_the_loop_stops_at_the_target_in_every_segment(tmp_path):
     """RSF's smooth trend reaches the target after one round, RSJ's bump later: RSF gets no more runs."""
     out = tmp_path / "target"

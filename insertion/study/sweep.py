@@ -10,7 +10,9 @@ Output folder::
 A run is identified by :meth:`InsertionCase.key` (a hash of every input). Rerunning a sweep into
 the same folder skips the keys already in the table, so a killed sweep loses at most the runs
 that were in flight; failed runs are recorded with their error (rerun them with
-``retry_failed=True``) and never stop the others. A folder holds one sweep: another sweep (other
+``retry_failed=True``) and never stop the others. ``reuse`` takes the finished runs of the same
+cases (the same key: every input equal) from other sweep folders instead of running them again;
+their rows keep the code version that made them. A folder holds one sweep: another sweep (other
 cases) written into it is refused, so that one table never mixes two sweeps.
 
 Runs go to a local process pool or an existing Dask distributed cluster
@@ -22,6 +24,7 @@ from __future__ import annotations
 
 import math
 import os
+import shutil
 import time
 from dataclasses import dataclass
 from pathlib import Path
@@ -151,6 +154,15 @@ class SweepStore:
         self.write()
         return row
 
+    def adopt(self, source, row) -> None:
+        """Take the finished run ``row`` of the sweep folder ``source``: its run folder copied
+        whole (or not at all), then its row, as it is (its code version included)."""
+        key = row["key"]
+        with output_set(self.folder / "runs") as stage:
+            shutil.copytree(Path(source) / "runs" / key, stage / key)
+        self.rows[key] = dict(row)
+        self.write()
+
     def table(self) -> pd.DataFrame:
         """All rows, contract columns first (older rows may add columns of removed inputs)."""
         frame = pd.DataFrame(list(self.rows.values()))
@@ -199,8 +211,27 @@ class SweepReport:
         return 3600.0 * self.ran / self.wall_time_s if self.ran and self.wall_time_s > 0 else math.nan
 
 
+def reusable_runs(folders, keys, out=None) -> dict:
+    """{key: (folder, row)} of the ok runs among ``keys`` in the sweep folders ``folders`` whose
+    run folder is there (the first folder that has a key gives it); ``out``, the sweep's own
+    folder, may not be one of them."""
+    found = {}
+    for folder in folders:
+        folder = Path(folder)
+        if out is not None and folder.resolve() == Path(out).resolve():
+            raise ColonsimError(f"--reuse {folder} is this sweep's own folder; name other sweep folders")
+        if not (folder / TABLE).is_file():
+            raise ColonsimError(f"--reuse {folder}: no {TABLE} there; name the folder of a sweep (its --out)")
+        for row in read_results(folder).to_dict("records"):
+            key = row["key"]
+            if (key in keys and key not in found and row["status"] == "ok"
+                    and (folder / "runs" / key / "summary.json").is_file()):
+                found[key] = (folder, row)
+    return found
+
+
 def run_sweep(cases, out, workers=2, scheduler=None, runner=None, retry_failed=False, spec=None,
-              progress=True, log=print, max_steps=DEFAULT_MAX_STEPS, pool=None) -> SweepReport:
+              progress=True, log=print, max_steps=DEFAULT_MAX_STEPS, pool=None, reuse=()) -> SweepReport:
     """Run every case of a sweep not yet finished in ``out``; record each run as it finishes.
 
     Parameters
@@ -226,6 +257,9 @@ def run_sweep(cases, out, workers=2, scheduler=None, runner=None, retry_failed=F
     pool : LocalPool or None
         Local worker processes to run on and leave open (several sweeps in a row); None: the
         sweep starts its own.
+    reuse : paths
+        Other sweep folders whose finished runs of the same cases are copied in, not run again
+        (:func:`reusable_runs`).
     """
     if workers < 1:
         raise ColonsimError(f"workers = {workers}; give at least 1 worker process")
@@ -241,6 +275,15 @@ def run_sweep(cases, out, workers=2, scheduler=None, runner=None, retry_failed=F
         store.check_same_sweep([c.key() for c in cases], spec.source if spec is not None else None)
         done = store.finished(retry_failed)
         todo = [c for c in cases if c.key() not in done]
+        if reuse:
+            taken = reusable_runs(reuse, {c.key() for c in todo}, out)
+            for folder, row in taken.values():
+                store.adopt(folder, row)
+            todo = [c for c in todo if c.key() not in taken]
+            if taken:
+                commits = sorted({str(row.get("git_commit") or "?")[:12] for _, row in taken.values()})
+                log(f"{len(taken)} run(s) of the same cases taken from {', '.join(str(f) for f in reuse)}, not run "
+                    f"again (made by code {', '.join(commits)})")
         skipped = len(cases) - len(todo)
         other = store.other_code({c.key() for c in cases} & done)
         if other:
@@ -289,5 +332,5 @@ def describe_cases(cases) -> str:
     return frame[["key", *varying]].to_string(index=False)
 
 
-__all__ = ["SweepStore", "SweepReport", "run_sweep", "read_results",
+__all__ = ["SweepStore", "SweepReport", "run_sweep", "reusable_runs", "read_results",
            "result_row", "input_row", "describe_cases", "IDENTITY", "OUTPUTS", "TABLE"]
