@@ -283,6 +283,19 @@ def _rate_cell(r):
     return {True: "passes", None: "-"}.get(r["rate"]["passed"], "NO: " + ", ".join(failed))
 
 
+def _turned_back_lines(rows) -> list:
+    """The runs whose tip ended turned back (docs/model.md, "Distal resistance"): their final
+    deformation and lag describe a fold of the scope, not a loop."""
+    back = [r for r in rows if r.get("tip_turned_back_cm") is not None]
+    if not back:
+        return []
+    runs = "; ".join(f"{r['segment'].upper()} {r['scope']} {r['where']} {r['level_N']:g} N from "
+                     f"{r['tip_turned_back_cm']:.1f} cm of push (final {num(r['final_deformation_cm'])} cm, largest "
+                     f"{num(r['max_deformation_cm'])} cm)" for r in back)
+    return [f"Tip turned back at the end ({len(back)} run(s); their final deformation and lag describe a fold of "
+            f"the scope in the exit, not a loop behind a held tip): {runs}.", ""]
+
+
 def markdown(section) -> list:
     """The section's Markdown lines."""
     lines = ["## 14. Distal resistance", "",
@@ -297,6 +310,7 @@ def markdown(section) -> list:
               f"{num(qs['largest'])})" + (": above it " + "; ".join(qs["above"]) if qs["above"] else "") + ".", ""]
     if section.get("remainder"):
         lines += _remainder_lines(section["remainder"])
+    lines += _turned_back_lines(section["rows"])
     if section["missing"]:
         lines += [f"Missing runs ({len(section['missing'])}): " + "; ".join(section["missing"]) + ".", ""]
     for segment in ("rsj", "rsf", "thf", "thf-fixed"):

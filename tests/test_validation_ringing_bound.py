@@ -61,3 +61,14 @@ def test_without_the_half_speed_run_there_is_no_verdict():
     assert resistance.ringing_bound(pd.Series(BASE), None, CASE)["bound"] is None
     other = dataclasses.replace(CASE, angle_deg=45.0)
     assert resistance.ringing_bound(pd.Series(BASE), HalfSweep(), other)["bound"] is None
+
+
+def test_runs_whose_tip_ended_turned_back_are_named():
+    """The resistance section names the runs whose final values describe a fold (a tip turned
+    back), and says nothing when there is none or when the sweep predates the column."""
+    row = {"segment": "rsf", "scope": "UTC (9.2 mm)", "where": "alpha 30 deg", "level_N": 20.0,
+           "final_deformation_cm": 0.0, "max_deformation_cm": 3.8, "tip_turned_back_cm": 59.4}
+    lines = resistance._turned_back_lines([row, {**row, "level_N": 10.0, "tip_turned_back_cm": None}])
+    assert len(lines) == 2 and "1 run(s)" in lines[0] and "RSF UTC (9.2 mm) alpha 30 deg 20 N from 59.4 cm" in lines[0]
+    assert resistance._turned_back_lines([{**row, "tip_turned_back_cm": None}]) == []
+    assert resistance._turned_back_lines([{k: v for k, v in row.items() if k != "tip_turned_back_cm"}]) == []
