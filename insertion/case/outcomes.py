@@ -164,10 +164,10 @@ def ringing_wavelength(depth, push_force, in_contact, window=RINGING_WINDOW, ste
 
     Returns NaN when under two windows of push were measured after the first contact.
     """
-    z, f = _from_first_contact(depth, push_force, in_contact)
-    if z.size < 3 or z[-1] - z[0] < 2.0 * window:
+    measured = _on_push_grid(depth, push_force, in_contact, window, step)
+    if measured is None:
         return float("nan")
-    grid, _, residual = _on_push_grid(z, f, window, step)
+    grid, _, residual = measured
     residual = (residual - residual.mean()) * np.hanning(grid.size)
     power = np.abs(np.fft.rfft(residual)) ** 2
     frequency = np.fft.rfftfreq(grid.size, step)  # cycles per m of push
@@ -177,9 +177,13 @@ def ringing_wavelength(depth, push_force, in_contact, window=RINGING_WINDOW, ste
     return float(1.0 / frequency[shorter][np.argmax(power[shorter])])
 
 
-def _on_push_grid(z, f, window, step):
-    """The push force and its ringing about the trend over ``window`` (:func:`ringing_ratio`)
-    resampled every ``step`` of push, pauses left out: the grid (m), the force and the ringing (N)."""
+def _on_push_grid(depth, push_force, in_contact, window, step):
+    """The push force after the first contact and its ringing about the trend over ``window``
+    (:func:`ringing_ratio`) resampled every ``step`` of push, pauses left out: the grid (m), the
+    force and the ringing (N); None when under two windows of push were measured."""
+    z, f = _from_first_contact(depth, push_force, in_contact)
+    if z.size < 3 or z[-1] - z[0] < 2.0 * window:
+        return None
     trend, _ = depth_trend(z, f, window)
     advancing = np.concatenate(([True], np.diff(z) > 0.0))  # a pause has one depth: keep its first sample
     grid = np.arange(z[0], z[-1], step)
@@ -202,10 +206,10 @@ def ringing_at_drops(depth, push_force, in_contact, window=RINGING_WINDOW, drop_
     Returns NaN values (``drops`` 0) when under two windows of push were measured after the
     first contact.
     """
-    z, f = _from_first_contact(depth, push_force, in_contact)
-    if z.size < 3 or z[-1] - z[0] < 2.0 * window:
+    measured = _on_push_grid(depth, push_force, in_contact, window, step)
+    if measured is None:
         return {"share": float("nan"), "push_share": float("nan"), "drops": 0}
-    grid, force, residual = _on_push_grid(z, f, window, step)
+    grid, force, residual = measured
     lag = max(int(round(drop_push / step)), 1)
     dropping = np.zeros(grid.size, dtype=bool)
     dropping[lag:] = force[:-lag] - force[lag:] > drop_N
