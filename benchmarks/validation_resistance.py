@@ -9,7 +9,8 @@ C per level and whether C > A once the tip is held back; and the rate check at 1
 speed) of one case per model. Runs missing from the table are listed, never filled in.
 
 The runs that ring above the limit are listed with what their ringing is made of and, given a sweep
-of the same runs at half the push speed (``benchmarks/sweeps/ringing_half_speed.toml``, passed as
+of the same runs at half the push speed (``benchmarks/sweeps/ringing_half_speed.toml``, written
+from the resistance sweep by ``benchmarks/ringing_half_speed.py``, passed as
 ``--ringing-half-sweep DIR``), with the proposed bound's verdict (docs/model.md, "Ringing that no
 push speed removes"): half the speed lowers the ratio by less than :data:`BOUND_RATIO_FALL` and
 the rate pair passes.
@@ -252,8 +253,8 @@ def _remainder_lines(remainder) -> list:
              "(`outcomes.ringing_at_drops`)")
     if not remainder.get("half_ran"):
         return [intro + ":", "", md_table(remainder["above"], columns), "",
-                f"The proposed bound: {NOT_RUN}: no --ringing-half-sweep (`colonsim sweep "
-                "benchmarks/sweeps/ringing_half_speed.toml --out DIR`).", ""]
+                f"The proposed bound: {NOT_RUN}: no --ringing-half-sweep (`python benchmarks/ringing_half_speed.py "
+                "RESISTANCE_SWEEP`, then `colonsim sweep benchmarks/sweeps/ringing_half_speed.toml --out DIR`).", ""]
     judged = [r for r in remainder["above"] if r["bound"] is not None]
     held = [r for r in judged if r["bound"]]
     columns += [("at half speed", lambda r: "-" if r["half_ratio"] is None else

@@ -72,3 +72,38 @@ def test_runs_whose_tip_ended_turned_back_are_named():
     assert len(lines) == 2 and "1 run(s)" in lines[0] and "RSF UTC (9.2 mm) alpha 30 deg 20 N from 59.4 cm" in lines[0]
     assert resistance._turned_back_lines([{**row, "tip_turned_back_cm": None}]) == []
     assert resistance._turned_back_lines([{k: v for k, v in row.items() if k != "tip_turned_back_cm"}]) == []
+
+
+class TableSweep:
+    """A resistance sweep's table as the generator reads it: (case, ringing ratio; None: failed) pairs."""
+
+    def __init__(self, *runs):
+        self.cases = [case for case, _ in runs]
+        self._ratios = {case.key(): ratio for case, ratio in runs}
+
+    def run(self, case):
+        ratio = self._ratios.get(case.key())
+        return (None, "failed") if ratio is None else (pd.Series({"ringing_ratio": ratio}), "ok")
+
+
+def test_the_half_speed_sweep_holds_the_runs_above_the_limit_and_reads_back_as_their_twins():
+    """benchmarks/ringing_half_speed.py: a run at or above the limit is written, one below it, a
+    failed one and one already at half the speed are not; the TOML parses to the keys the report
+    looks up (every input that differs from the defaults, the resistance of 0 N included)."""
+    import ringing_half_speed as generator
+    from colonsim.insertion.case.outcomes import RINGING_LIMIT
+    from colonsim.insertion.study.sweep_spec import parse_sweep
+
+    quiet = dataclasses.replace(CASE, angle_deg=45.0)
+    held = InsertionCase(segment="thf-fixed", scope="13.3", angle_deg=45.0, distal_resistance_N=20.0,
+                         exit_length_mm=400.0)
+    failed = dataclasses.replace(CASE, scope="11.1")
+    slow = dataclasses.replace(CASE, push_speed=HALF_SPEED)
+    sweep = TableSweep((CASE, 0.30), (quiet, 0.05), (held, RINGING_LIMIT), (failed, None), (slow, 0.5))
+    cases = generator.ringing_cases(sweep)
+    assert cases == [CASE, held]
+    text = generator.half_speed_toml(cases, "abc1234")
+    assert "distal_resistance_N = 0.0" in text and "exit_length_mm = 400.0" in text and "The 2 runs" in text
+    keys = [c.key() for c in parse_sweep(text).cases]
+    assert keys == [resistance.half_speed_twin(c).key() for c in cases]
+    assert quiet.key() not in keys and CASE.key() not in keys
