@@ -17,7 +17,6 @@ from __future__ import annotations
 
 import argparse
 import dataclasses
-import math
 import sys
 from pathlib import Path
 
@@ -26,7 +25,7 @@ from colonsim.insertion.case.insertion_case import InsertionCase
 from colonsim.insertion.case.outcomes import RINGING_LIMIT
 from colonsim.insertion.study.sweep_presets import HALF_SPEED
 from colonsim.insertion.study.sweep_spec import parse_sweep
-from validation_resistance import half_speed_twin
+from validation_resistance import half_speed_twin, measured_ringing
 from validation_sweeps import read_sweep
 
 OUT = Path(__file__).resolve().parent / "sweeps" / "ringing_half_speed.toml"
@@ -35,14 +34,7 @@ OUT = Path(__file__).resolve().parent / "sweeps" / "ringing_half_speed.toml"
 def ringing_cases(sweep) -> list:
     """The cases of ``sweep`` run at the default push speed whose ringing ratio is at or above the
     limit (the report's "above the limit"), in the sweep's order."""
-    speed = InsertionCase().push_speed
-    out = []
-    for case in sweep.cases:
-        row = sweep.run(case)[0] if math.isclose(case.push_speed, speed) else None
-        ratio = None if row is None else row.get("ringing_ratio")
-        if ratio is not None and math.isfinite(ratio) and ratio >= RINGING_LIMIT:
-            out.append(case)
-    return out
+    return [case for case, _, ratio in measured_ringing(sweep, InsertionCase().push_speed) if ratio >= RINGING_LIMIT]
 
 
 def _toml_value(name, value) -> str:

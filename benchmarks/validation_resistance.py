@@ -135,6 +135,16 @@ def _quasi_static(rows) -> dict:
             "largest": max(ratios) if ratios else None, "above": above}
 
 
+def measured_ringing(sweep, speed):
+    """(case, row, ringing ratio) of each run of ``sweep`` at the push speed ``speed`` whose table
+    row holds a ringing ratio, in the sweep's order."""
+    for case in sweep.cases:
+        row = sweep.run(case)[0] if math.isclose(case.push_speed, speed) else None
+        ratio = _number(row, "ringing_ratio")
+        if ratio is not None:
+            yield case, row, ratio
+
+
 def ringing_remainder(sweep, speed, half=None) -> dict:
     """The runs at the default speed that ring above the limit (``above``): the ringing in newtons
     next to the mean push force it is divided by, the push distance it repeats over
@@ -144,11 +154,7 @@ def ringing_remainder(sweep, speed, half=None) -> dict:
     (:func:`ringing_bound`); and the ringing in newtons of the runs below the limit
     (``rms_below_N``), for scale."""
     above, rms_below = [], []
-    for case in sweep.cases:
-        row, _ = sweep.run(case) if math.isclose(case.push_speed, speed) else (None, None)
-        ratio = _number(row, "ringing_ratio")
-        if ratio is None:
-            continue
+    for case, row, ratio in measured_ringing(sweep, speed):
         qs = sweep.summary(row).get("quasi_static") or {}
         if ratio < RINGING_LIMIT:
             if qs.get("push_force_rms_N") is not None:
