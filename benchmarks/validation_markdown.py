@@ -8,6 +8,7 @@ from colonsim.files import atomic_path
 from colonsim.insertion.case.run_summary import ENDINGS
 from colonsim.insertion.study.verification_rules import GROUPS
 from colonsim.markdown import NOT_RUN, md_table, num, percent
+from validation_carry import carried_lines
 from validation_changes import markdown as changes_markdown
 from validation_resistance import markdown as resistance_markdown
 
@@ -20,6 +21,10 @@ def header(doc):
     h = doc["header"]
 
     def sweep_line(s):
+        if s.get("carried_from"):
+            mark = s["carried_from"]
+            return f"carried from the report of {mark['date']}: " + sweep_line({k: v for k, v in s.items()
+                                                                               if k != "carried_from"})
         if s["folder"] is None:
             return f"{NOT_RUN} (not given: --validation-sweep)"
         if not s["ran"]:
@@ -36,6 +41,8 @@ def header(doc):
         f"- command: `{h['command']}`",
         f"- main sweep: {sweep_line(h['sweeps']['main'])}",
         f"- validation sweep: {sweep_line(h['sweeps']['validation'])}",
+        *([f"- sections carried from the previous report (their sweeps not given; each says so under its heading): "
+           + ", ".join(h["carried"])] if h.get("carried") else []),
         f"- size of the verification part: **{h['size']}**"
         + (" (CI sizes of the tests, quick calibration budget)" if h["size"] == "reduced"
            else " (full sizes of the tests, default calibration budget)"),
@@ -201,7 +208,7 @@ PAIR_SHOWN = ("final", "max", "A", "C", "peak contact", "peak push")
 
 
 def _pair_section(number, title, intro, section):
-    lines = [f"## {number}. {title}", "", intro, ""]
+    lines = [f"## {number}. {title}", "", intro, ""] + carried_lines(section)
     if not section["ran"]:
         return lines + [f"{NOT_RUN}: {section['note']}", ""]
     rows = []
@@ -267,7 +274,7 @@ def ringing(section):
              "its moving average over 1 cm of push, over its mean, from the first contact to the end of the push, "
              f"every sample weighted by the push it stands for. Quasi-static: below {section['limit']:g}.", ""]
     for name, s in section["sweeps"].items():
-        lines += [f"### {name.capitalize()} sweep", ""]
+        lines += [f"### {name.capitalize()} sweep", ""] + carried_lines(s)
         if not s["ran"]:
             lines += [f"{NOT_RUN}.", ""]
             continue
@@ -300,6 +307,7 @@ def smoothness(section):
              "scatter about a smooth trend (the noise sd the surrogate fitted on both GP sweeps estimates, table "
              "below): 2 % of a small range can lie below the scatter." + _scatter_alone(section["cubic"]), ""]
     cubic = section["cubic"]
+    lines += carried_lines(cubic)
     if not cubic["ran"]:
         lines += [f"{NOT_RUN}: no --smoothness-sweep.", ""]
     else:
@@ -326,6 +334,7 @@ def smoothness(section):
               "larger of theirs). Held-out runs carry that scatter: where it is above 5 %, more training runs cannot "
               "pass the check; where it is well below and the error on both sweeps is too, 20 runs were too few.", ""]
     gp = section["surrogate"]
+    lines += carried_lines(gp)
     if not gp["ran"]:
         lines += [f"{NOT_RUN}: no --gp-train-sweep and --gp-test-sweep.", ""]
     else:
@@ -347,7 +356,7 @@ def flexure_sensitivity(section):
              "matching a result). RSF and THF at alpha / beta = " + (" and ".join(f"{a:g}" for a in angles) or "-")
              + " deg with the UTC (9.2 mm) and the SDC (13.3 mm): the 90 deg runs are the main sweep's, the other "
              "turns the validation sweep's. Advantage = (SDC - UTC) / SDC of the final deformation (0 where both "
-             "are below 0.1 cm, as in the claims).", ""]
+             "are below 0.1 cm, as in the claims).", ""] + carried_lines(section)
     if not section["ran"]:
         return lines + [f"{NOT_RUN}: {section['note']}", ""]
 
@@ -388,7 +397,7 @@ def run_ends(sections):
              f"({ENDINGS['jam']}). End state: pushed depth, push and contact force at the end.", ""]
     for name, s in sections.items():
         sweep = s["sweep"]
-        lines += [f"### {name.capitalize()} sweep", ""]
+        lines += [f"### {name.capitalize()} sweep", ""] + carried_lines(s)
         if not sweep["ran"]:
             lines += [f"{NOT_RUN}: " + (f"no results table in `{sweep['folder']}`." if sweep["folder"]
                                         else "no sweep given."), ""]

@@ -164,7 +164,7 @@ def _angles(claim, main, segment, flexure_rows):
                    + ", ".join(f"{x:.0%}" for x in on_max) + f" at {symbol} = " + ", ".join(f"{a:g}" for a in angles) + ".")
     turns = [r for r in flexure_rows if r["segment"] == segment and r["advantage"] is not None]
     if turns:
-        out.append("UTC advantage at other flexure turns (section 8): " + "; ".join(
+        out.append("UTC advantage at other flexure turns (section 10): " + "; ".join(
             f"{symbol} {r['angle_deg']:g}, flexure {r['flexure_angle_deg']:g} deg: {r['advantage']:.0%}" for r in turns) + ".")
     return out
 

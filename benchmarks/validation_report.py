@@ -42,6 +42,7 @@ from colonsim.insertion.study.sweep_presets import HALF_SPEED
 from colonsim.insertion.case.outcomes import RINGING_LIMIT
 from colonsim.insertion.study.claims import evaluate_claims
 
+import validation_carry
 import validation_changes as changes
 import validation_checks as checks
 import validation_figures as figures
@@ -55,7 +56,7 @@ from validation_sweeps import paired, read_sweep
 SYMBOL = {"rsf": "alpha", "thf": "beta"}
 
 
-def header(args, started, main, validation):
+def header(args, started, sweeps):
     # taken when the script started (code_version caches it), before it rewrote its own outputs
     recorded = code_version()["git_commit"] or "unknown (not a git checkout)"
     commit, dirty = recorded.removesuffix("+modified"), recorded.endswith("+modified")
@@ -66,7 +67,7 @@ def header(args, started, main, validation):
             "commit_note": "uncommitted changes in tracked files" if dirty else "clean tree",
             "machine": f"{platform.system()} {platform.machine()}, {os.cpu_count()} cores, Python {platform.python_version()}",
             "command": command, "size": args.size,
-            "sweeps": {"main": main.describe(), "validation": validation.describe()}}
+            "sweeps": {label: sweep.describe() for label, sweep in sweeps.items()}}
 
 
 def shape_figure(entries, path, title, out):
@@ -196,6 +197,9 @@ def main(argv=None):
     parser.add_argument("--previous", type=Path, default=None,
                         help="the previous report's report.json (a copy: the new report replaces it); adds the "
                              "section on what moved since, which says NOT RUN without it")
+    parser.add_argument("--carry", action="store_true",
+                        help="take every section whose sweep is not given from --previous, marked with the report "
+                             "and code it comes from, instead of saying NOT RUN (benchmarks/validation_carry.py)")
     parser.add_argument("--out", type=Path, default=Path("docs/validation"), help="output folder (default docs/validation)")
     parser.add_argument("--size", choices=("reduced", "full"), default="reduced",
                         help="verification at the CI test sizes and quick calibration budget, or at full size")
@@ -211,6 +215,9 @@ def main(argv=None):
                 ("gp_test", args.gp_test_sweep), ("resistance", args.resistance_sweep),
                 ("rate_angles", args.rate_angles_sweep), ("ringing_half", args.ringing_half_sweep)))
         previous = None if args.previous is None else read_previous(args.previous)
+        if args.carry and previous is None:
+            raise ColonsimError("--carry takes the sections of the sweeps not given from the previous report: "
+                                "give it with --previous OLD/report.json")
     except ColonsimError as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 2
@@ -235,9 +242,16 @@ def main(argv=None):
     figures.rsj_deformation(curves, out / "figures" / "rsj_deformation.png")
     figs["rsj_deformation"] = {"file": "figures/rsj_deformation.png"}
     sensitivity = flexure_section(validation, main_sweep, out)
+    given = {"validation": args.validation_sweep, "rate_angles": args.rate_angles_sweep,
+             "smoothness": args.smoothness_sweep, "gp_train": args.gp_train_sweep, "gp_test": args.gp_test_sweep,
+             "resistance": args.resistance_sweep, "ringing_half": args.ringing_half_sweep}
+    if args.carry and args.validation_sweep is None:  # the claims' readings cite the flexure turns (section 10)
+        sensitivity = validation_carry.carried_section(previous, "validation", ("flexure_sensitivity",)) or sensitivity
     claims = add_readings([c.to_dict() for c in evaluate_claims(main_sweep.table)], main_sweep, sensitivity["rows"])
     times = sections.run_times(main_sweep)
-    doc = {"header": header(args, started, main_sweep, validation), "verification": verification,
+    described = {"main": main_sweep, "validation": validation, "smoothness": smooth, "gp_train": gp_train,
+                 "gp_test": gp_test, "resistance": resisted, "rate_angles": angles, "ringing_half": ringing_half}
+    doc = {"header": header(args, started, described), "verification": verification,
            "calibration": calibration, "rsj": {"rows": rsj_rows, "checks": sections.rsj_checks(rsj_rows)},
            "claims": claims, "flexure_models": flexure_models(main_sweep, out),
            "ringing": {"limit": RINGING_LIMIT, "sweeps": {"main": sections.ringing_rows(main_sweep),
@@ -259,6 +273,8 @@ def main(argv=None):
     doc["timings"] = {"verification_s": t_verification, "calibration_s": t_calibration,
                       "total_s": time.perf_counter() - t0}
     doc = _clean(doc)
+    if args.carry:
+        doc["header"]["carried"] = validation_carry.carry(doc, previous, {k: v is not None for k, v in given.items()})
     doc["changes"] = changes.changes(previous, doc)  # both documents as JSON holds them (NaN -> null)
     write_json(out / "report.json", doc)
     write_markdown(doc, out / "report.md")

@@ -28,6 +28,7 @@ from colonsim.insertion.case.outcomes import RINGING_LIMIT, ringing_at_drops, ri
 from colonsim.insertion.study.claims import evaluate_claims
 from colonsim.insertion.study.sweep_presets import HALF_SPEED
 from colonsim.markdown import NOT_RUN, md_table, num
+from validation_carry import carried_lines
 from validation_resistance_readings import claim_readings
 from validation_sections import PAIR_QUANTITIES, case_geometry, pair_quantities
 from validation_sweeps import role, scope_label
@@ -309,7 +310,7 @@ def markdown(section) -> list:
              "The colon beyond the model holds the tip back (docs/model.md, \"Loading\", distal resistance): the "
              "`resistance` preset runs every colon model at 0 / 5 / 10 / 20 N (none, light, typical, difficult), the "
              "source's angles and the three meshed scopes, and the rate check at 10 N. Lag: pushed depth minus the "
-             "tip's advance along the centerline.", ""]
+             "tip's advance along the centerline.", ""] + carried_lines(section)
     if not section["ran"]:
         return lines + [f"{NOT_RUN}: no --resistance-sweep (`colonsim sweep --preset resistance --out DIR`).", ""]
     qs = section["quasi_static"]
