@@ -207,6 +207,9 @@ def main(argv=None):
     started = datetime.datetime.now(datetime.timezone.utc)
     t0 = time.perf_counter()
     try:
+        if args.carry and args.previous is None:
+            raise ColonsimError("--carry takes the sections of the sweeps not given from the previous report: "
+                                "give it with --previous OLD/report.json")
         main_sweep = read_sweep("main", args.sweep)
         validation = read_sweep("validation", args.validation_sweep, preset="validation")
         smooth, gp_train, gp_test, resisted, angles, ringing_half = (
@@ -215,9 +218,6 @@ def main(argv=None):
                 ("gp_test", args.gp_test_sweep), ("resistance", args.resistance_sweep),
                 ("rate_angles", args.rate_angles_sweep), ("ringing_half", args.ringing_half_sweep)))
         previous = None if args.previous is None else read_previous(args.previous)
-        if args.carry and previous is None:
-            raise ColonsimError("--carry takes the sections of the sweeps not given from the previous report: "
-                                "give it with --previous OLD/report.json")
     except ColonsimError as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 2

@@ -12,6 +12,7 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "benchmarks"))
 
 import validation_carry as carry  # noqa: E402
+import validation_report  # noqa: E402
 from validation_markdown import write_markdown  # noqa: E402
 
 LANDED = json.loads((ROOT / "docs" / "validation" / "report.json").read_text(encoding="utf-8"))
@@ -94,3 +95,10 @@ def test_the_markdown_says_under_each_carried_heading_that_it_was_carried_and_no
     for heading in ("3. RSJ against", "9. Smooth across inputs", "13. Run times"):
         assert note not in next(s for h, s in sections.items() if h.startswith(heading)), heading
     assert "sections carried from the previous report" in text and "validation sweep: carried from" in text
+
+
+def test_carry_without_a_previous_report_is_a_one_line_error_before_anything_is_read(tmp_path, capsys):
+    assert validation_report.main(["--sweep", str(tmp_path / "nowhere"), "--carry", "--out", str(tmp_path)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert "\n" not in err and "--previous OLD/report.json" in err
+    assert not (tmp_path / "report.md").exists()
