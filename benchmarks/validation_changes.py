@@ -120,9 +120,24 @@ def _claims_reproduced(doc, part):
     return {level: sum(c["levels"].get(level, {}).get("verdict") == "REPRODUCED" for c in claims) for level in levels}
 
 
+def _claim_flips(previous, current):
+    """The source's claims (main sweep) whose verdict changed: name, before, after."""
+    old = {c["name"]: c.get("verdict") for c in previous.get("claims") or []}
+    return [{"claim": c.get("statement") or c["name"], "before": old[c["name"]], "after": c.get("verdict")}
+            for c in current.get("claims") or [] if c["name"] in old and old[c["name"]] != c.get("verdict")]
+
+
+def _reproduced(doc):
+    claims = doc.get("claims")
+    return None if not claims else sum(c.get("verdict") == "REPRODUCED" for c in claims)
+
+
 def _summaries(previous, current):
-    """The ringing summaries, the claims reproduced per level and the smoothness and surrogate rows."""
-    rows = [{"what": label, "before": _get(previous, *path), "after": _get(current, *path)}
+    """The ringing summaries, the claims reproduced (main sweep, and per level of the resistance sweep)
+    and the smoothness and surrogate rows."""
+    rows = [{"what": "main sweep: the source's claims reproduced", "before": _reproduced(previous),
+             "after": _reproduced(current)}]
+    rows += [{"what": label, "before": _get(previous, *path), "after": _get(current, *path)}
             for label, path in (("main sweep: largest ringing ratio", ("ringing", "sweeps", "main", "largest")),
                                 ("main sweep: runs below the ringing limit", ("ringing", "sweeps", "main", "passed")),
                                 ("resistance sweep: largest ringing ratio", ("resistance", "quasi_static", "largest")),
@@ -152,7 +167,9 @@ def changes(previous: dict | None, current: dict) -> dict:
     return {"ran": True, "previous": {"date": header.get("date"), "commit": header.get("commit"),
                                       "sweeps": {k: v.get("code") for k, v in header.get("sweeps", {}).items()}},
             "runs": runs, "moved": [r for r in runs if any(q["moved"] for q in r["quantities"])],
-            "flips": flips, "pair_counts": {"before": counts_before, "after": counts_after},
+            "flips": flips, "claim_flips": _claim_flips(previous, current),
+            "carried": (current.get("header") or {}).get("carried") or [],
+            "pair_counts": {"before": counts_before, "after": counts_after},
             "summaries": _summaries(previous, current)}
 
 
@@ -180,7 +197,9 @@ def markdown(section) -> list:
               f"{100 * MOVED:g} % or more (deformations below {SMALL_CM:g} cm: by {MOVED_CM:g} cm or more, shown as the "
               f"absolute change). Of the {len(section['runs'])} runs the report's tables show in both (RSJ at mu 0, every RSF, THF and "
               f"fixed THF run of the main sweep, and {n_resisted} of the distal resistance sweep), "
-              f"{len(section['moved'])} moved.", ""]
+              f"{len(section['moved'])} moved."
+              + (" The sections of the sweeps carried from the previous report (" + ", ".join(section["carried"])
+                 + ") are its runs and compare equal." if section.get("carried") else ""), ""]
     tables = {"rsj": [], "main": [], "resistance": []}  # one table each: their rows show different quantities
     for r in section["moved"]:
         tables["resistance" if r.get("sweep") == "resistance" else "rsj" if r["run"].startswith("RSJ ") else
@@ -197,6 +216,9 @@ def markdown(section) -> list:
         lines += [md_table(section["flips"], [("check", "check"), ("run", "run"), ("quantity", "quantity"),
                                               ("change before", lambda r: percent(r["before"], "+.1f")),
                                               ("change now", lambda r: percent(r["after"], "+.1f")), ("verdict", "verdict")]), ""]
+    if section.get("claim_flips"):
+        lines += ["The source's claims (main sweep, section 4) whose verdict changed:", "",
+                  md_table(section["claim_flips"], [("claim", "claim"), ("before", "before"), ("now", "after")]), ""]
     if section["summaries"]:
         lines += [md_table(section["summaries"], [("what", "what"), ("before", lambda r: num(r["before"])),
                                                   ("now", lambda r: num(r["after"]))]), ""]

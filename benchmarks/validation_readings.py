@@ -146,7 +146,7 @@ def _rsj_friction(claim, main):
     return out
 
 
-def _angles(claim, main, segment, flexure_rows):
+def _angles(claim, main, segment, flexure_rows, flexure_source):
     symbol = "alpha" if segment == "rsf" else "beta"
     angles = sorted({float(k.rsplit("_", 1)[-1]) for e in claim["evidence"] for k in e if k.startswith("advantage_")})
     out = []
@@ -164,13 +164,14 @@ def _angles(claim, main, segment, flexure_rows):
                    + ", ".join(f"{x:.0%}" for x in on_max) + f" at {symbol} = " + ", ".join(f"{a:g}" for a in angles) + ".")
     turns = [r for r in flexure_rows if r["segment"] == segment and r["advantage"] is not None]
     if turns:
-        out.append("UTC advantage at other flexure turns (section 10): " + "; ".join(
+        out.append(f"UTC advantage at other flexure turns ({flexure_source}): " + "; ".join(
             f"{symbol} {r['angle_deg']:g}, flexure {r['flexure_angle_deg']:g} deg: {r['advantage']:.0%}" for r in turns) + ".")
     return out
 
 
-def add_readings(claims, main, flexure_rows):
-    """Give every NOT REPRODUCED claim a ``reading``: a list of sentences from the numbers."""
+def add_readings(claims, main, flexure_rows, flexure_source="section 10"):
+    """Give every NOT REPRODUCED claim a ``reading``: a list of sentences from the numbers (``flexure_source``:
+    where the flexure turns' rows come from, as the reading cites them)."""
     for claim in claims:
         claim["reading"] = []
         if claim["verdict"] != NOT_REPRODUCED:
@@ -185,5 +186,5 @@ def add_readings(claims, main, flexure_rows):
         elif name == "sc_less_friction_sensitive":
             claim["reading"] = _rsj_friction(claim, main)
         elif name.startswith("angle_dependence_"):
-            claim["reading"] = _angles(claim, main, name.rsplit("_", 1)[-1], flexure_rows)
+            claim["reading"] = _angles(claim, main, name.rsplit("_", 1)[-1], flexure_rows, flexure_source)
     return claims

@@ -245,9 +245,14 @@ def main(argv=None):
     given = {"validation": args.validation_sweep, "rate_angles": args.rate_angles_sweep,
              "smoothness": args.smoothness_sweep, "gp_train": args.gp_train_sweep, "gp_test": args.gp_test_sweep,
              "resistance": args.resistance_sweep, "ringing_half": args.ringing_half_sweep}
+    flexure_source = "section 10"
     if args.carry and args.validation_sweep is None:  # the claims' readings cite the flexure turns (section 10)
-        sensitivity = validation_carry.carried_section(previous, "validation", ("flexure_sensitivity",)) or sensitivity
-    claims = add_readings([c.to_dict() for c in evaluate_claims(main_sweep.table)], main_sweep, sensitivity["rows"])
+        carried = validation_carry.carried_section(previous, "validation", ("flexure_sensitivity",))
+        if carried is not None:
+            sensitivity = carried
+            flexure_source = f"section 10, carried from the report of {carried['carried_from']['date']}"
+    claims = add_readings([c.to_dict() for c in evaluate_claims(main_sweep.table)], main_sweep, sensitivity["rows"],
+                          flexure_source)
     times = sections.run_times(main_sweep)
     described = {"main": main_sweep, "validation": validation, "smoothness": smooth, "gp_train": gp_train,
                  "gp_test": gp_test, "resistance": resisted, "rate_angles": angles, "ringing_half": ringing_half}

@@ -78,3 +78,17 @@ def test_the_distal_resistance_runs_their_rate_pairs_and_claims_are_compared():
     # unmoved: the same run at the same numbers is matched and not listed
     same = changes.changes(resisted(3.06, 0.012, False), resisted(3.06, 0.012, False))
     assert len(same["runs"]) == 3 and not same["moved"] and not same["flips"]
+
+
+def test_a_claim_whose_verdict_flipped_is_listed_and_counted_and_an_unchanged_one_is_not():
+    before, after = report(0.96, 1.83, 0.0, "a"), report(0.96, 1.83, 0.0, "a")
+    before["claims"] = [{"name": "x", "statement": "Thin scopes deform less.", "verdict": "NOT REPRODUCED"},
+                        {"name": "y", "statement": "Friction matters less.", "verdict": "REPRODUCED"}]
+    after["claims"] = [{"name": "x", "statement": "Thin scopes deform less.", "verdict": "REPRODUCED"},
+                       {"name": "y", "statement": "Friction matters less.", "verdict": "REPRODUCED"}]
+    section = changes.changes(before, after)
+    assert section["claim_flips"] == [{"claim": "Thin scopes deform less.", "before": "NOT REPRODUCED",
+                                       "after": "REPRODUCED"}]
+    assert {"what": "main sweep: the source's claims reproduced", "before": 1, "after": 2} in section["summaries"]
+    assert "| Thin scopes deform less. | NOT REPRODUCED | REPRODUCED |" in "\n".join(changes.markdown(section))
+    assert changes.changes(before, before)["claim_flips"] == []
