@@ -187,11 +187,21 @@ def model_runs(rows):
     return md_table(rows, columns)
 
 
+def _relax(section):
+    """How long the released colon relaxes before the push goes on, as the section's runs did."""
+    short, longest = section.get("relax_s"), section.get("relax_max_s")
+    if short is None:
+        return "`relax`"
+    if not longest:
+        return f"`relax`, {short:g} s"
+    return f"`relax`: {short:g} s, then on until the released colon has come to rest, at most {longest:g} s in all"
+
+
 def flexure_models(section):
     lines = ["## 5. RSF, THF and fixed THF", "",
              "Main sweep, mu = 0, flexure turn 90 deg (the default; docs/model.md, \"Colon models\"). The mobile part "
              "is held to its straight axis while the scope straightens it (phase `straighten`) and slows to rest at "
-             "the end of the mobile part (`stop`), released while the scope stands still (`relax`, 0.1 s), then the "
+             "the end of the mobile part (`stop`), released while the scope stands still (" + _relax(section) + "), then the "
              "scope is pushed through the flexure into the fixed exit (`push`) until its available length is used "
              "or the tip reaches the far end (docs/model.md, \"Loading\"); the phases are those each run's "
              "`timeseries.csv` records. Phases: pushed depth at the phase's start and end, and the largest and the last "

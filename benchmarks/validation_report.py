@@ -95,7 +95,8 @@ def flexure_models(main, out):
         fig = shape_figure(entries, f"figures/{segment}_shapes.png",
                            f"{segment.upper()}, main sweep: final shapes per angle", out)
         figs += [fig] if fig else []
-    return {"rows": sections.public(rows), "figures": figs}
+    case = InsertionCase()
+    return {"rows": sections.public(rows), "figures": figs, "relax_s": case.relax_s, "relax_max_s": case.relax_max_s}
 
 
 def resistance_section(sweep, half, out):
