@@ -243,9 +243,8 @@ def main(argv=None):
     figures.rsj_deformation(curves, out / "figures" / "rsj_deformation.png")
     figs["rsj_deformation"] = {"file": "figures/rsj_deformation.png"}
     sensitivity = flexure_section(validation, main_sweep, out)
-    given = {"validation": args.validation_sweep, "rate_angles": args.rate_angles_sweep,
-             "smoothness": args.smoothness_sweep, "gp_train": args.gp_train_sweep, "gp_test": args.gp_test_sweep,
-             "resistance": args.resistance_sweep, "ringing_half": args.ringing_half_sweep}
+    described = {"main": main_sweep, "validation": validation, "smoothness": smooth, "gp_train": gp_train,
+                 "gp_test": gp_test, "resistance": resisted, "rate_angles": angles, "ringing_half": ringing_half}
     flexure_source = "section 10"
     if args.carry and args.validation_sweep is None:  # the claims' readings cite the flexure turns (section 10)
         carried = validation_carry.carried_section(previous, "validation", ("flexure_sensitivity",))
@@ -255,8 +254,6 @@ def main(argv=None):
     claims = add_readings([c.to_dict() for c in evaluate_claims(main_sweep.table)], main_sweep, sensitivity["rows"],
                           flexure_source)
     times = sections.run_times(main_sweep)
-    described = {"main": main_sweep, "validation": validation, "smoothness": smooth, "gp_train": gp_train,
-                 "gp_test": gp_test, "resistance": resisted, "rate_angles": angles, "ringing_half": ringing_half}
     doc = {"header": header(args, started, described), "verification": verification,
            "calibration": calibration, "rsj": {"rows": rsj_rows, "checks": sections.rsj_checks(rsj_rows)},
            "claims": claims, "flexure_models": flexure_models(main_sweep, out),
@@ -280,7 +277,8 @@ def main(argv=None):
                       "total_s": time.perf_counter() - t0}
     doc = _clean(doc)
     if args.carry:
-        doc["header"]["carried"] = validation_carry.carry(doc, previous, {k: v is not None for k, v in given.items()})
+        doc["header"]["carried"] = validation_carry.carry(
+            doc, previous, {label: sweep.folder is not None for label, sweep in described.items()})
     doc["changes"] = changes.changes(previous, doc)  # both documents as JSON holds them (NaN -> null)
     write_json(out / "report.json", doc)
     write_markdown(doc, out / "report.md")
