@@ -14,6 +14,8 @@ from __future__ import annotations
 
 import copy
 
+from validation_changes import section_at
+
 # sweep label -> the report document's sections computed from that sweep (paths into the document)
 SECTIONS = {
     "validation": (("header", "sweeps", "validation"), ("mesh_pair",), ("rate_check",), ("flexure_sensitivity",),
@@ -27,14 +29,6 @@ SECTIONS = {
 # parts of a carried section that belong to another sweep and so stay as this report computed them
 # (they are carried, or not, by that sweep's own entry above)
 OWN_PARTS = {("rate_check",): ("angles",)}
-
-
-def _get(doc, path):
-    for key in path:
-        if not isinstance(doc, dict) or key not in doc:
-            return None
-        doc = doc[key]
-    return doc
 
 
 def _mark(previous, label):
@@ -54,7 +48,7 @@ def carried_section(previous, label, path):
     """A copy of ``previous``'s section at ``path`` (computed from sweep ``label``), marked with where
     it was computed (a mark it already has is kept); None where ``previous`` has no such section or
     its sweep had not run there either."""
-    old = _get(previous, path)
+    old = section_at(previous, *path)
     if not isinstance(old, dict) or not _ran(old):
         return None
     section = copy.deepcopy(old)
@@ -74,7 +68,7 @@ def carry(doc, previous, given):
             section = carried_section(previous, label, path)
             if section is None:
                 continue
-            parent = _get(doc, path[:-1])
+            parent = section_at(doc, *path[:-1])
             for part in OWN_PARTS.get(path, ()):
                 if part in parent[path[-1]]:
                     section[part] = parent[path[-1]][part]

@@ -69,7 +69,7 @@ def _resisted_runs(previous, current):
     """The distal resistance sweep's runs, matched by model, scope, where and level."""
     def by_case(doc):
         return {(r["segment"], r["role"], r["where"], r["level_N"]): r
-                for r in _get(doc, "resistance", "rows") or []}
+                for r in section_at(doc, "resistance", "rows") or []}
 
     old = by_case(previous)
     return [{"run": f"{k[0].upper()} {r['scope']} {k[2]}, {k[3]:g} N", "sweep": "resistance",
@@ -87,7 +87,7 @@ def _verdicts(previous, current):
             for r in (section or {}).get("rows", []) or []:
                 for q in r.get("quantities", []):
                     found[(name, r["segment"], r["scope"], r["inputs"], q["quantity"])] = q
-        for r in _get(doc, "resistance", "rate") or []:  # the rate check of the resistance sweep (10 N)
+        for r in section_at(doc, "resistance", "rate") or []:  # the rate check of the resistance sweep (10 N)
             for quantity, q in (r.get("changes") or {}).items():
                 found[(RESISTED_RATE, r["segment"], r["scope"], f"{r['where']}, {r['level_N']:g} N", quantity)] = q
         return found
@@ -106,7 +106,7 @@ def _verdicts(previous, current):
     return flips, count(old), count(new)
 
 
-def _get(doc, *path):
+def section_at(doc, *path):
     """``doc[path[0]][path[1]]...``, None where a level is missing (an older report, a section not run)."""
     for key in path:
         doc = doc.get(key) if isinstance(doc, dict) else None
@@ -115,7 +115,7 @@ def _get(doc, *path):
 
 def _claims_reproduced(doc, part):
     """Per distal resistance level, how many of the source's claims are reproduced."""
-    claims = _get(doc, "resistance", part) or []
+    claims = section_at(doc, "resistance", part) or []
     levels = {level for c in claims for level in (c.get("levels") or {})}
     return {level: sum(c["levels"].get(level, {}).get("verdict") == "REPRODUCED" for c in claims) for level in levels}
 
@@ -137,7 +137,7 @@ def _summaries(previous, current):
     and the smoothness and surrogate rows."""
     rows = [{"what": "main sweep: the source's claims reproduced", "before": _reproduced(previous),
              "after": _reproduced(current)}]
-    rows += [{"what": label, "before": _get(previous, *path), "after": _get(current, *path)}
+    rows += [{"what": label, "before": section_at(previous, *path), "after": section_at(current, *path)}
             for label, path in (("main sweep: largest ringing ratio", ("ringing", "sweeps", "main", "largest")),
                                 ("main sweep: runs below the ringing limit", ("ringing", "sweeps", "main", "passed")),
                                 ("resistance sweep: largest ringing ratio", ("resistance", "quasi_static", "largest")),
@@ -150,8 +150,8 @@ def _summaries(previous, current):
                  for level in sorted(new, key=float)]
     for label, part, key in (("smoothness: departure from a cubic, share of range", "cubic", "departure"),
                              ("surrogate held-out RMSE, share of spread", "surrogate", "share")):
-        old = {r["output"]: r for r in _get(previous, "smoothness", part, "rows") or []}
-        for r in _get(current, "smoothness", part, "rows") or []:
+        old = {r["output"]: r for r in section_at(previous, "smoothness", part, "rows") or []}
+        for r in section_at(current, "smoothness", part, "rows") or []:
             if r["output"] in old:
                 rows.append({"what": f"{label}: {r['output']}", "before": old[r["output"]].get(key), "after": r.get(key)})
     return rows

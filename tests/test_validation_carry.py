@@ -57,9 +57,9 @@ def test_the_sections_of_sweeps_not_given_come_from_the_previous_report_marked_w
     marks = {}
     for path in (("mesh_pair",), ("flexure_sensitivity",), ("resistance",), ("smoothness", "cubic"),
                  ("ringing", "sweeps", "validation"), ("run_ends", "validation")):
-        section = copy.deepcopy(carry._get(doc, path))
+        section = copy.deepcopy(carry.section_at(doc, *path))
         marks[path] = mark = section.pop("carried_from")
-        assert section == carry._get(LANDED, path), path
+        assert section == carry.section_at(LANDED, *path), path
         assert mark["date"] == LANDED["header"]["date"] and mark["commit"] == LANDED["header"]["commit"]
     # the validation sweep's rows name the code that made them, as the landed header does
     assert marks[("mesh_pair",)]["rows_code"] == LANDED["header"]["sweeps"]["validation"]["code"]
