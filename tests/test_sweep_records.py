@@ -1,0 +1,141 @@
+"""Sweep records (benchmarks/sweep_records.py): a sweep folder packed and unpacked again gives the
+report the same table, summaries, time series (to the record's quantum) and final shapes; a record
+grows run by run; the report never asks a sweep for a column a record leaves out; bad folders are
+one line."""
+
+import json
+import re
+import sys
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT / "benchmarks"))
+
+import sweep_records as records  # noqa: E402
+from validation_sweeps import Sweep  # noqa: E402
+
+from colonsim.errors import ColonsimError  # noqa: E402
+from colonsim.insertion.case.results import read_final_shape  # noqa: E402
+
+
+def _run_folder(folder, key, seed, n=400):
+    """A run folder as `colonsim sweep` writes it: every series column plus one the record drops."""
+    rng = np.random.default_rng(seed)
+    run = folder / "runs" / key
+    run.mkdir(parents=True)
+    depth = np.cumsum(rng.uniform(0.0, 0.02, n))
+    series = pd.DataFrame({
+        "time_s": np.arange(n) * 1e-3, "phase": np.where(np.arange(n) < n // 2, "push", "settle"),
+        "depth_cm": depth, "deformation_cm": np.abs(np.sin(depth)) * rng.uniform(0.5, 2.0),
+        "tip_arc_cm": depth - 0.1 * np.sin(depth), "push_force_N": rng.normal(4.0, 0.7, n),
+        "contact_nodes": rng.integers(0, 40, n), "kinetic_colon_J": rng.uniform(0, 1e-3, n)})
+    series.to_csv(run / "timeseries.csv", index=False)
+    (run / "summary.json").write_text(json.dumps({"key": key, "points_cm": {"A": {"depth_cm": 1.0}}}), encoding="utf-8")
+    shape = {"colon_m": rng.normal(0.0, 0.05, (300, 3)), "scope_m": rng.normal(0.0, 0.2, (60, 3))}
+    np.savez_compressed(run / "final_shape.npz", **shape)
+    return {"key": key, "status": "ok", "timeseries_path": f"runs/{key}/timeseries.csv",
+            "final_deformation_cm": float(series["deformation_cm"].iloc[-1]), "git_commit": "abc"}, series, shape
+
+
+def _sweep(folder, keys, failed=(), seed=0, name="demo", defined=None):
+    folder.mkdir(parents=True, exist_ok=True)
+    rows, made = [], {}
+    for i, key in enumerate(keys):
+        row, series, shape = _run_folder(folder, key, seed + i)
+        rows.append(row)
+        made[key] = (series, shape)
+    rows += [{"key": k, "status": "failed", "timeseries_path": "", "final_deformation_cm": np.nan,
+              "git_commit": "abc"} for k in failed]
+    pd.DataFrame(rows).to_parquet(folder / "results.parquet", index=False)
+    all_keys = list(defined or (list(keys) + list(failed)))  # the cases the sweep defines, finished or not
+    (folder / "sweep.json").write_text(json.dumps({"name": name, "keys": all_keys, "toml": "x"}), encoding="utf-8")
+    return made
+
+
+def test_pack_then_unpack_gives_the_report_the_same_run(tmp_path):
+    made = _sweep(tmp_path / "sweep", ["k1", "k2"], failed=["k3"])
+    done = records.pack(tmp_path / "sweep", tmp_path / "record")
+    assert done == {"packed": 3, "incomplete": [], "rows": 3}
+    records.unpack(tmp_path / "record", tmp_path / "again")
+    before = pd.read_parquet(tmp_path / "sweep" / "results.parquet")
+    after = pd.read_parquet(tmp_path / "again" / "results.parquet")
+    pd.testing.assert_frame_equal(before.sort_values("key").reset_index(drop=True),
+                                  after.sort_values("key").reset_index(drop=True))
+    assert json.loads((tmp_path / "again" / "sweep.json").read_text()) == json.loads(
+        (tmp_path / "sweep" / "sweep.json").read_text())
+    for key, (series, shape) in made.items():
+        run = tmp_path / "again" / "runs" / key
+        assert (run / "summary.json").read_bytes() == (tmp_path / "sweep" / "runs" / key / "summary.json").read_bytes()
+        back = pd.read_csv(run / "timeseries.csv")
+        assert list(back.columns) == list(records.SERIES_COLUMNS)
+        for col in records.SERIES_COLUMNS:
+            if col in records.SERIES_QUANTUM:  # rounded to the quantum, never further: the steps add up exactly
+                np.testing.assert_allclose(back[col], series[col], rtol=0, atol=0.5 * records.SERIES_QUANTUM[col] * 1.001)
+            else:
+                assert (back[col] == series[col]).all()
+        shape_back = read_final_shape(run)
+        for name, x in shape.items():
+            np.testing.assert_allclose(shape_back[name], x, rtol=0, atol=0.5 * records.SHAPE_QUANTUM * 1.001)
+    assert not (tmp_path / "again" / "runs" / "k3").exists()
+
+
+def test_the_report_reads_an_unpacked_record_as_the_sweep(tmp_path):
+    _sweep(tmp_path / "sweep", ["k1", "k2"])
+    records.pack(tmp_path / "sweep", tmp_path / "record")
+    records.unpack(tmp_path / "record", tmp_path / "again")
+    table = pd.read_parquet(tmp_path / "sweep" / "results.parquet")
+    original = Sweep("main", tmp_path / "sweep", [], table, True)
+    unpacked = Sweep("main", tmp_path / "again", [], pd.read_parquet(tmp_path / "again" / "results.parquet"), True)
+    for _, row in table.iterrows():
+        assert unpacked.summary(row) == original.summary(row)
+        a = original.timeseries(row, ["phase", "depth_cm", "push_force_N"])
+        b = unpacked.timeseries(row, ["phase", "depth_cm", "push_force_N"])
+        assert (a["phase"] == b["phase"]).all()
+        assert np.abs(a["depth_cm"] - b["depth_cm"]).max() <= 0.5e-5 * 1.001
+
+
+def test_a_record_grows_over_sittings_and_keeps_what_a_later_folder_lacks(tmp_path):
+    _sweep(tmp_path / "first", ["k1"], seed=1, defined=["k1", "k2"])
+    records.pack(tmp_path / "first", tmp_path / "record")
+    # the next sitting: the record unpacked, one more run added by the resumed sweep
+    records.unpack(tmp_path / "record", tmp_path / "second")
+    row, _, _ = _run_folder(tmp_path / "second", "k2", 7)
+    table = pd.concat([pd.read_parquet(tmp_path / "second" / "results.parquet"), pd.DataFrame([row])])
+    table.to_parquet(tmp_path / "second" / "results.parquet", index=False)
+    assert records.pack(tmp_path / "second", tmp_path / "record")["rows"] == 2
+    # a folder holding only one of them does not take the other out of the record
+    _sweep(tmp_path / "third", ["k2"], seed=7, defined=["k1", "k2"])
+    assert records.pack(tmp_path / "third", tmp_path / "record")["rows"] == 2
+    assert sorted(pd.read_parquet(tmp_path / "record" / "results.parquet")["key"]) == ["k1", "k2"]
+
+
+def test_a_run_folder_that_is_not_complete_is_left_out_and_named(tmp_path):
+    _sweep(tmp_path / "sweep", ["k1", "k2"])
+    (tmp_path / "sweep" / "runs" / "k2" / "final_shape.npz").unlink()
+    done = records.pack(tmp_path / "sweep", tmp_path / "record")
+    assert done["incomplete"] == ["k2"] and done["rows"] == 1
+
+
+def test_bad_folders_are_one_line(tmp_path, capsys):
+    assert records.main(["pack", str(tmp_path / "nothing"), str(tmp_path / "record")]) == 2
+    assert "no results.parquet" in capsys.readouterr().err
+    _sweep(tmp_path / "a", ["k1"], name="a")
+    _sweep(tmp_path / "b", ["k9"], name="b")
+    records.pack(tmp_path / "a", tmp_path / "record")
+    with pytest.raises(ColonsimError, match="records another sweep"):
+        records.pack(tmp_path / "b", tmp_path / "record")
+    assert records.main(["unpack", str(tmp_path / "a"), str(tmp_path / "b")]) == 2
+    assert "another sweep" in capsys.readouterr().err
+
+
+def test_every_column_the_report_reads_is_recorded():
+    asked = set()
+    for path in (ROOT / "benchmarks").glob("validation_*.py"):
+        for call in re.findall(r"\.timeseries\(\s*row\s*,\s*\[([^\]]*)\]", path.read_text(encoding="utf-8")):
+            asked |= set(re.findall(r"\"([^\"]+)\"", call))
+    assert asked, "the report's modules ask a sweep for time-series columns"
+    assert asked <= set(records.SERIES_COLUMNS), asked - set(records.SERIES_COLUMNS)
