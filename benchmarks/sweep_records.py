@@ -117,35 +117,54 @@ def _sweep_document(folder: Path):
     return json.loads(path.read_text(encoding="utf-8")) if path.is_file() else None
 
 
-def _check_same(record: Path, sweep: Path):
-    mine, theirs = _sweep_document(record), _sweep_document(sweep)
+def _check_same(source: Path, target: Path):
+    mine, theirs = _sweep_document(source), _sweep_document(target)
     if mine is not None and theirs is not None and set(mine.get("keys", ())) != set(theirs.get("keys", ())):
-        raise ColonsimError(f"{record} records another sweep ({mine.get('name')!r}) than {sweep} "
-                            f"({theirs.get('name')!r}); pack into another record folder")
+        raise ColonsimError(f"{target} holds another sweep ({theirs.get('name')!r}) than {source} "
+                            f"({mine.get('name')!r}); give another folder")
 
 
-def _write_frame(path: Path, frame: pd.DataFrame):
-    with atomic_path(path) as tmp:
-        frame.to_parquet(tmp, index=False, compression="zstd")
+def _folders(source, target, needs):
+    """(source, target, source table, target table or an empty one) of a pack or unpack, checked."""
+    source, target = Path(source), Path(target)
+    if not (source / TABLE).is_file():
+        raise ColonsimError(f"no {TABLE} in {source}; give {needs}")
+    if target.exists() and not target.is_dir():
+        raise ColonsimError(f"{target} is a file; give a folder")
+    _check_same(source, target)
+    table = read_results(source)
+    return source, target, table, read_results(target) if (target / TABLE).is_file() else table.iloc[0:0]
+
+
+def _merge(source, target, have, rows) -> int:
+    """Write ``target``'s table: its rows ``have`` with ``rows`` in place of theirs (by key); the
+    sweep document of ``source`` beside it. Returns the number of rows."""
+    fresh = {r["key"] for r in rows}
+    merged = pd.concat([have[~have["key"].isin(fresh)], pd.DataFrame(rows)], ignore_index=True) if rows else have
+    with atomic_path(target / TABLE) as tmp:
+        merged.to_parquet(tmp, index=False, compression="zstd")
+    document = _sweep_document(source)
+    if document is not None:
+        write_json(target / SWEEP_DOCUMENT, document)
+    return len(merged)
 
 
 def pack(sweep_dir, record_dir) -> dict:
     """Add the finished runs of the sweep folder ``sweep_dir`` to the record ``record_dir``.
 
     A run is packed when its row says ok or failed; an ok run also needs its summary, time series
-    and final shape in its run folder (else it is left out and named). Returns the counts."""
-    sweep, record = Path(sweep_dir), Path(record_dir)
-    if not (sweep / TABLE).is_file():
-        raise ColonsimError(f"no {TABLE} in {sweep}; give the folder of a sweep (its --out)")
-    if record.exists() and not record.is_dir():
-        raise ColonsimError(f"{record} is a file; give a folder for the record")
-    _check_same(record, sweep)
-    table = read_results(sweep)
-    kept = read_results(record) if (record / TABLE).is_file() else table.iloc[0:0]
-    rows, packed, incomplete = [], 0, []
+    and final shape in its run folder (else it is left out and named). A run the record holds
+    already (the same key, finished at the same time) is left as it is, so that packing again
+    rewrites no file of it. Returns the counts."""
+    sweep, record, table, kept = _folders(sweep_dir, record_dir, "the folder of a sweep (its --out)")
+    held = {r["key"]: r.get("finished_at") for r in kept.to_dict("records")}
+    rows, incomplete = [], []
     with output_set(record / "runs") as stage:
         for row in table.to_dict("records"):
             key = row["key"]
+            if key in held and held[key] == row.get("finished_at") and (row["status"] != "ok"
+                                                                         or (record / "runs" / key).is_dir()):
+                continue
             run = sweep / Path(str(row["timeseries_path"])).parent if row.get("timeseries_path") else None
             if row["status"] == "ok":
                 files = [run / "summary.json", run / "timeseries.csv", run / "final_shape.npz"] if run else []
@@ -159,31 +178,19 @@ def pack(sweep_dir, record_dir) -> dict:
                 pack_series(series).to_parquet(target / SERIES, index=False, compression="zstd")
                 np.savez_compressed(target / SHAPE, **pack_shape(read_final_shape(run)))
             rows.append(row)
-            packed += 1
-    fresh = {r["key"] for r in rows}
-    merged = pd.concat([kept[~kept["key"].isin(fresh)], pd.DataFrame(rows)], ignore_index=True) if rows else kept
-    _write_frame(record / TABLE, merged)
-    document = _sweep_document(sweep)
-    if document is not None:
-        write_json(record / SWEEP_DOCUMENT, document)
+    total = _merge(sweep, record, kept, rows)
     log = json.loads((record / LOG).read_text(encoding="utf-8")) if (record / LOG).is_file() else []
     log.append({"date": datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds"),
-                "packed_by": code_version().get("git_commit"), "from": str(sweep), "runs": packed,
-                "left_out": incomplete, "rows_after": len(merged)})
+                "packed_by": code_version().get("git_commit"), "from": str(sweep), "runs": len(rows),
+                "left_out": incomplete, "rows_after": total})
     write_json(record / LOG, log)
-    return {"packed": packed, "incomplete": incomplete, "rows": len(merged)}
+    return {"packed": len(rows), "incomplete": incomplete, "rows": total}
 
 
 def unpack(record_dir, sweep_dir) -> dict:
     """Write the record ``record_dir`` as a sweep folder ``sweep_dir`` (new, or one of the same
     sweep: its rows and run folders of the record's runs are replaced). Returns the counts."""
-    record, sweep = Path(record_dir), Path(sweep_dir)
-    if not (record / TABLE).is_file():
-        raise ColonsimError(f"no {TABLE} in {record}; give a record folder written by `sweep_records.py pack`")
-    if sweep.exists() and not sweep.is_dir():
-        raise ColonsimError(f"{sweep} is a file; give a folder for the sweep")
-    _check_same(record, sweep)
-    table = read_results(record)
+    record, sweep, table, have = _folders(record_dir, sweep_dir, "a record folder written by `sweep_records.py pack`")
     rows = []
     with output_set(sweep / "runs") as stage:
         for row in table.to_dict("records"):
@@ -197,12 +204,7 @@ def unpack(record_dir, sweep_dir) -> dict:
                     np.savez_compressed(target / "final_shape.npz", **unpack_shape({n: data[n] for n in data.files}))
                 row = {**row, "timeseries_path": f"runs/{row['key']}/timeseries.csv"}
             rows.append(row)
-    have = read_results(sweep) if (sweep / TABLE).is_file() else table.iloc[0:0]
-    fresh = {r["key"] for r in rows}
-    _write_frame(sweep / TABLE, pd.concat([have[~have["key"].isin(fresh)], pd.DataFrame(rows)], ignore_index=True))
-    document = _sweep_document(record)
-    if document is not None:
-        write_json(sweep / SWEEP_DOCUMENT, document)
+    _merge(record, sweep, have, rows)
     return {"unpacked": len(rows)}
 
 

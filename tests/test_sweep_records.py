@@ -38,7 +38,8 @@ def _run_folder(folder, key, seed, n=400):
     shape = {"colon_m": rng.normal(0.0, 0.05, (300, 3)), "scope_m": rng.normal(0.0, 0.2, (60, 3))}
     np.savez_compressed(run / "final_shape.npz", **shape)
     return {"key": key, "status": "ok", "timeseries_path": f"runs/{key}/timeseries.csv",
-            "final_deformation_cm": float(series["deformation_cm"].iloc[-1]), "git_commit": "abc"}, series, shape
+            "final_deformation_cm": float(series["deformation_cm"].iloc[-1]), "git_commit": "abc",
+            "finished_at": f"2026-12-01T00:00:{seed:02d}"}, series, shape
 
 
 def _sweep(folder, keys, failed=(), seed=0, name="demo", defined=None):
@@ -49,7 +50,7 @@ def _sweep(folder, keys, failed=(), seed=0, name="demo", defined=None):
         rows.append(row)
         made[key] = (series, shape)
     rows += [{"key": k, "status": "failed", "timeseries_path": "", "final_deformation_cm": np.nan,
-              "git_commit": "abc"} for k in failed]
+              "git_commit": "abc", "finished_at": "2026-12-01T01:00:00"} for k in failed]
     pd.DataFrame(rows).to_parquet(folder / "results.parquet", index=False)
     all_keys = list(defined or (list(keys) + list(failed)))  # the cases the sweep defines, finished or not
     (folder / "sweep.json").write_text(json.dumps({"name": name, "keys": all_keys, "toml": "x"}), encoding="utf-8")
@@ -106,10 +107,15 @@ def test_a_record_grows_over_sittings_and_keeps_what_a_later_folder_lacks(tmp_pa
     row, _, _ = _run_folder(tmp_path / "second", "k2", 7)
     table = pd.concat([pd.read_parquet(tmp_path / "second" / "results.parquet"), pd.DataFrame([row])])
     table.to_parquet(tmp_path / "second" / "results.parquet", index=False)
-    assert records.pack(tmp_path / "second", tmp_path / "record")["rows"] == 2
-    # a folder holding only one of them does not take the other out of the record
-    _sweep(tmp_path / "third", ["k2"], seed=7, defined=["k1", "k2"])
-    assert records.pack(tmp_path / "third", tmp_path / "record")["rows"] == 2
+    first = {p.name: p.read_bytes() for p in (tmp_path / "record" / "runs" / "k1").iterdir()}
+    done = records.pack(tmp_path / "second", tmp_path / "record")
+    assert done["rows"] == 2 and done["packed"] == 1  # k1, held already, is not packed again
+    assert {p.name: p.read_bytes() for p in (tmp_path / "record" / "runs" / "k1").iterdir()} == first
+    # a folder holding only one of them, a later run of k2, replaces k2 and keeps k1
+    made = _sweep(tmp_path / "third", ["k2"], seed=8, defined=["k1", "k2"])
+    assert records.pack(tmp_path / "third", tmp_path / "record") == {"packed": 1, "incomplete": [], "rows": 2}
+    np.testing.assert_allclose(records.unpack_series(pd.read_parquet(tmp_path / "record" / "runs" / "k2" / "series.parquet"))
+                               ["depth_cm"], made["k2"][0]["depth_cm"], rtol=0, atol=1e-5)
     assert sorted(pd.read_parquet(tmp_path / "record" / "results.parquet")["key"]) == ["k1", "k2"]
 
 
@@ -126,7 +132,7 @@ def test_bad_folders_are_one_line(tmp_path, capsys):
     _sweep(tmp_path / "a", ["k1"], name="a")
     _sweep(tmp_path / "b", ["k9"], name="b")
     records.pack(tmp_path / "a", tmp_path / "record")
-    with pytest.raises(ColonsimError, match="records another sweep"):
+    with pytest.raises(ColonsimError, match="holds another sweep"):
         records.pack(tmp_path / "b", tmp_path / "record")
     assert records.main(["unpack", str(tmp_path / "a"), str(tmp_path / "b")]) == 2
     assert "another sweep" in capsys.readouterr().err
