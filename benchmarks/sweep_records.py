@@ -22,6 +22,7 @@ Use::
 
     python benchmarks/sweep_records.py pack SWEEP_DIR RECORD_DIR     # add SWEEP_DIR's finished runs
     python benchmarks/sweep_records.py unpack RECORD_DIR SWEEP_DIR   # a sweep folder again
+    python benchmarks/sweep_records.py status [RECORDS_DIR]          # what each record holds
 
 ``pack`` adds the finished runs of a sweep folder to a record (a new record, or one of the same
 sweep: the same ``sweep.json``), keeping the runs the record has that the folder lacks. ``unpack``
@@ -208,6 +209,18 @@ def unpack(record_dir, sweep_dir) -> dict:
     return {"unpacked": len(rows)}
 
 
+def status(record_dir) -> dict:
+    """What a record holds: its sweep's name, the runs it defines, the rows recorded (ok / failed)
+    and the commits that made them."""
+    record = Path(record_dir)
+    if not (record / TABLE).is_file():
+        raise ColonsimError(f"no {TABLE} in {record}; give a record folder written by `sweep_records.py pack`")
+    table, document = read_results(record), _sweep_document(record) or {}
+    return {"record": record.name, "sweep": document.get("name"), "defined": len(document.get("keys", ())) or None,
+            "ok": int((table["status"] == "ok").sum()), "failed": int((table["status"] != "ok").sum()),
+            "code": {str(k)[:12]: int(v) for k, v in table.get("git_commit", pd.Series(dtype=str)).value_counts().items()}}
+
+
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     sub = parser.add_subparsers(dest="command", required=True)
@@ -217,9 +230,17 @@ def main(argv=None) -> int:
     u = sub.add_parser("unpack", help="write a record as a sweep folder")
     u.add_argument("record")
     u.add_argument("sweep")
+    st = sub.add_parser("status", help="what the records in a folder hold")
+    st.add_argument("records", nargs="?", default=str(Path(__file__).resolve().parent / "records"))
     args = parser.parse_args(argv)
     try:
-        if args.command == "pack":
+        if args.command == "status":
+            for folder in sorted(p for p in Path(args.records).iterdir() if (p / TABLE).is_file()):
+                s = status(folder)
+                code = ", ".join(f"{c}: {n}" for c, n in s["code"].items())
+                print(f"{s['record']}: sweep {s['sweep']!r}, {s['ok']} ok + {s['failed']} failed of "
+                      f"{s['defined'] or '?'} defined; rows' code {code}")
+        elif args.command == "pack":
             done = pack(args.sweep, args.record)
             print(f"packed {done['packed']} runs into {args.record} ({done['rows']} in the record)"
                   + (f"; left out, their run folders incomplete: {', '.join(done['incomplete'])}"

@@ -119,6 +119,15 @@ def test_a_record_grows_over_sittings_and_keeps_what_a_later_folder_lacks(tmp_pa
     assert sorted(pd.read_parquet(tmp_path / "record" / "results.parquet")["key"]) == ["k1", "k2"]
 
 
+def test_status_says_what_a_record_holds(tmp_path, capsys):
+    _sweep(tmp_path / "sweep", ["k1", "k2"], failed=["k3"], defined=["k1", "k2", "k3", "k4"], name="thesis")
+    records.pack(tmp_path / "sweep", tmp_path / "records" / "thesis")
+    assert records.status(tmp_path / "records" / "thesis") == {
+        "record": "thesis", "sweep": "thesis", "defined": 4, "ok": 2, "failed": 1, "code": {"abc": 3}}
+    assert records.main(["status", str(tmp_path / "records")]) == 0
+    assert "thesis: sweep 'thesis', 2 ok + 1 failed of 4 defined; rows' code abc: 3" in capsys.readouterr().out
+
+
 def test_a_run_folder_that_is_not_complete_is_left_out_and_named(tmp_path):
     _sweep(tmp_path / "sweep", ["k1", "k2"])
     (tmp_path / "sweep" / "runs" / "k2" / "final_shape.npz").unlink()
