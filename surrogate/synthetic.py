@@ -37,7 +37,7 @@ def synthetic_outputs(segment, scope_diameter_mm, diameter_mm, angle_deg, fricti
             "max_wall_stretch": 1.05 + 0.03 * final}
 
 
-def synthetic_sweep(n_runs=40, segments=("rsj", "rsf"), noise_cm=0.03, design="random", n_failed=1, seed=0):
+def synthetic_sweep(n_runs=40, segments=("rsj", "rsf"), noise_cm=0.03, design="random", n_failed=1, seed=0, repeats=1):
     """A SYNTHETIC results table in the sweep's format.
 
     ``design="random"``: per segment ``n_runs`` runs with inputs drawn uniformly (scope 9.2-12.8 mm,
@@ -45,6 +45,9 @@ def synthetic_sweep(n_runs=40, segments=("rsj", "rsf"), noise_cm=0.03, design="r
     the project runs - UTC/PDC/SDC x diameters 23/36 (RSJ) or angles 0/30/45 x friction 0/0.05/0.1.
     ``noise_cm``: standard deviation of the noise added to the deformation outputs (others get
     a proportional share). ``n_failed`` runs per segment have status "failed" and NaN outputs.
+    ``repeats``: each case of the design that many times, with its own scatter (a sweep that runs
+    its cases again: with 2, the grid's 18 RSJ and 27 RSF runs become 36 and 54, enough for a
+    model without replicate runs to state its error, ``validation.MIN_RUNS_PER_INPUT``).
     """
     rng = np.random.default_rng(seed)
     rows = []
@@ -57,7 +60,7 @@ def synthetic_sweep(n_runs=40, segments=("rsj", "rsf"), noise_cm=0.03, design="r
         else:
             grid = [("custom", round(rng.uniform(9.2, 12.8), 3), rng.uniform(23.0, 36.0) if segment == "rsj" else 36.0,
                      rng.uniform(0.0, 45.0) if angled else 0.0, rng.uniform(0.0, 0.1)) for _ in range(n_runs)]
-        for i, (scope, d, D, a, mu) in enumerate(grid):
+        for i, (scope, d, D, a, mu) in enumerate(grid * int(repeats)):
             out = synthetic_outputs(segment, d, D, a, mu)
             noisy = {k: float(v) + (0.0 if np.isnan(v) else rng.normal(0.0, noise_cm) * (1.0 if k.endswith("_cm") else 0.2))
                      for k, v in out.items()}

@@ -13,7 +13,7 @@ from colonsim.surrogate.synthetic import synthetic_sweep
 @pytest.fixture(scope="module")
 def fitted(tmp_path_factory):
     folder = tmp_path_factory.mktemp("surrogate")
-    synthetic_sweep(design="grid", noise_cm=0.02, seed=1).to_parquet(folder / "results.parquet")
+    synthetic_sweep(design="grid", noise_cm=0.02, seed=1, repeats=2).to_parquet(folder / "results.parquet")
     code = main(["surrogate", "fit", str(folder / "results.parquet"), "-o", str(folder / "model"), "--restarts", "0",
                  "--targets", "max_deformation_cm", "point_C_cm", "peak_contact_force_N"])
     assert code == 0
@@ -24,7 +24,7 @@ def test_fit_writes_model_and_reports_cv(fitted, capsys):
     assert (fitted / "model.json").is_file() and (fitted / "model.npz").is_file()
     assert main(["surrogate", "info", str(fitted / "model.json")]) == 0
     text = capsys.readouterr().out
-    assert "CV RMSE" in text and "95% coverage" in text and "rsf: 26 runs" in text
+    assert "CV RMSE" in text and "95% coverage" in text and "rsf: 53 runs" in text
     assert "averaged over 16 hyperparameter draws" in text  # the default up to 100 runs
 
 

@@ -35,7 +35,7 @@ def blocks(kind):
 @pytest.fixture
 def workdir(tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)
-    synthetic_sweep(design="grid").to_parquet(tmp_path / "results.parquet")
+    synthetic_sweep(design="grid", repeats=2).to_parquet(tmp_path / "results.parquet")  # the grid run twice
     synthetic_sweep(n_runs=30, n_failed=0, seed=7).to_parquet(tmp_path / "held_out.parquet")
     csv = next(b for b in blocks("") if b.startswith("segment,"))
     (tmp_path / "queries.csv").write_text(csv)

@@ -44,6 +44,13 @@ def train():
 
 
 @pytest.fixture(scope="module")
+def known():
+    """Runs enough for a model without replicate runs to know its error: 10 per input (scope,
+    colon diameter, friction; validation.MIN_RUNS_PER_INPUT)."""
+    return rsj(30, seed=11)
+
+
+@pytest.fixture(scope="module")
 def test_table():
     return rsj(40, seed=12)
 
@@ -101,10 +108,10 @@ def test_validate_command(floored, test_table, tmp_path, capsys):
     assert "the model itself prints no interval (too few runs" in text
 
 
-def test_validate_command_of_a_model_that_knows_its_error(train, test_table, tmp_path, capsys):
+def test_validate_command_of_a_model_that_knows_its_error(known, test_table, tmp_path, capsys):
     from colonsim.surrogate.store import save_surrogate
 
-    save_surrogate(SweepSurrogate(targets=(TARGET,), n_restarts=1).fit(train), tmp_path / "model")
+    save_surrogate(SweepSurrogate(targets=(TARGET,), n_restarts=1).fit(known), tmp_path / "model")
     test_table.to_parquet(tmp_path / "test.parquet")
     assert main(["surrogate", "validate", str(tmp_path / "model.json"), str(tmp_path / "test.parquet")]) == 0
     text = capsys.readouterr().out
@@ -124,10 +131,10 @@ def test_validate_refuses_a_table_without_the_model_inputs(floored, test_table, 
 
 
 # -- too few runs to know its error -----------------------------------------------------------------
-def test_error_is_known_with_enough_runs_and_an_estimated_noise(train):
+def test_error_is_known_with_enough_runs_and_an_estimated_noise(known):
     from colonsim.surrogate.recommend import format_recommendation, recommend
 
-    model = SweepSurrogate(targets=(TARGET,), n_restarts=1).fit(train)
+    model = SweepSurrogate(targets=(TARGET,), n_restarts=1).fit(known)
     assert model.error_unknown("rsj", TARGET) is None
     rec = recommend(model, "rsj", {"diameter_mm": 30.0, "friction": 0.05})
     assert rec["p_ranking"] is not None and all(s["low95"] is not None for s in rec["scopes"])
@@ -168,13 +175,31 @@ def test_noise_at_its_bound_is_not_an_estimate():
     assert measured.error_unknown("rsj", TARGET) is None
 
 
-def test_cross_validated_errors_larger_than_the_sd_make_the_error_unknown(train):
+def test_cross_validated_errors_larger_than_the_sd_make_the_error_unknown(known):
     from colonsim.surrogate.validation import error_unknown
 
-    model = SweepSurrogate(targets=(TARGET,), n_restarts=1).fit(train)  # the noise estimated
+    model = SweepSurrogate(targets=(TARGET,), n_restarts=1).fit(known)  # the noise estimated
     gp, cv = model.models_["rsj"][TARGET], dict(model.cv_["rsj"][TARGET])
     assert error_unknown(cv, gp) is None and cv["z_rms"] < 1.3
-    assert "1.6 times the sd it states (at most 1.23 with 24 runs)" in error_unknown({**cv, "z_rms": 1.6}, gp)
+    assert "1.6 times the sd it states (at most 1.21 with 30 runs)" in error_unknown({**cv, "z_rms": 1.6}, gp)
+
+
+def test_without_replicate_runs_ten_runs_per_input_are_needed(known, train):
+    """Without replicate runs a model of fewer than 10 runs per input says its error is unknown, even
+    where its noise was estimated and its cross-validated errors agree with its sd; from 10 per
+    input, or with replicate runs, that rule does not silence it."""
+    from colonsim.surrogate.validation import MIN_RUNS_PER_INPUT, error_unknown
+
+    assert MIN_RUNS_PER_INPUT == 10
+    small = SweepSurrogate(targets=(TARGET,), n_restarts=1).fit(known.iloc[:29])
+    gp, cv = small.models_["rsj"][TARGET], small.cv_["rsj"][TARGET]
+    assert gp.noise_level_ > 1.05 * gp.noise_bottom() and cv["z_rms"] < 1.3  # no other check would catch it
+    assert error_unknown(cv, gp) == ("too few runs to know its error without replicate runs (29 < 10 per input, 30 for "
+                                     "its 3); fit more runs, or measure the scatter with replicate runs (fit --replicates)")
+    assert SweepSurrogate(targets=(TARGET,), n_restarts=1).fit(known).error_unknown("rsj", TARGET) is None
+    measured = SweepSurrogate(targets=(TARGET,), n_restarts=1,
+                              replicates=replicates_of(train, 8, seed=3, noise=0.01, shared=True)).fit(train)
+    assert "without replicate runs" not in (measured.error_unknown("rsj", TARGET) or "")
 
 
 def test_fit_with_replicates_on_the_command_line(train, tmp_path, capsys):

@@ -124,7 +124,7 @@ def test_a_gp_on_runs_linear_in_mu0_recovers_the_tissue_part(tissue_model):
 
 
 def test_one_material_fits_exactly_as_before_and_old_tables_still_fit():
-    old = synthetic_sweep(design="grid", noise_cm=0.02, seed=1)
+    old = synthetic_sweep(design="grid", noise_cm=0.02, seed=1, repeats=2)
     one = old.assign(**{WALL_MU0: 86.97452, WALL_C11: 219.1203, "material_parameters": ""})
     a, b = (SweepSurrogate(targets=(TARGET,), n_restarts=0).fit(t) for t in (old, one))
     assert a.domains_["rsj"].inputs == b.domains_["rsj"].inputs and b.domains_["rsj"].fixed[WALL_MU0] == 86.97452
@@ -176,7 +176,7 @@ def test_the_tissue_distribution_is_saved_without_pickle(tissue_model, tmp_path)
 def fitted(tmp_path_factory):
     folder = tmp_path_factory.mktemp("tissue")
     tissue_table().to_parquet(folder / "results.parquet")
-    synthetic_sweep(design="grid", noise_cm=0.02, seed=1).to_parquet(folder / "old.parquet")
+    synthetic_sweep(design="grid", noise_cm=0.02, seed=1, repeats=2).to_parquet(folder / "old.parquet")
     for table, name in (("results", "model"), ("old", "old")):
         assert main(["surrogate", "fit", str(folder / f"{table}.parquet"), "-o", str(folder / name), "--restarts", "0",
                      "--targets", TARGET]) == 0
