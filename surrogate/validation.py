@@ -73,7 +73,7 @@ def error_unknown(cv: dict, gp) -> str | None:
     if n < MIN_CHECKED_RUNS:
         return f"too few runs to know its error ({n} < {MIN_CHECKED_RUNS})"
     collapsed = [p for p in getattr(gp, "parts", (gp,)) if noise_at_bottom(p)]  # a LargerOf: either part
-    if any(p.noise_bottom() <= p.noise_bounds[0] for p in collapsed):  # at the nominal bound, not a floor
+    if any(not replicate_floored(p) for p in collapsed):  # at the nominal bound, not a floor
         return ("too few runs to know its error: the fit put the run-to-run scatter at the bottom of its range instead "
                 "of estimating it; measure it with replicate runs (fit --replicates)")
     if collapsed:
@@ -81,7 +81,7 @@ def error_unknown(cv: dict, gp) -> str | None:
                 "measured instead of estimating it, and that floor is only part of the scatter; fit more runs")
     parts = getattr(gp, "parts", (gp,))
     inputs = int(parts[0].X_train_.shape[1])
-    if all(p.noise_bottom() <= p.noise_bounds[0] for p in parts) and n < MIN_RUNS_PER_INPUT * inputs:
+    if not any(replicate_floored(p) for p in parts) and n < MIN_RUNS_PER_INPUT * inputs:
         return (f"too few runs to know its error without replicate runs ({n} < {MIN_RUNS_PER_INPUT} per input, "
                 f"{MIN_RUNS_PER_INPUT * inputs} for its {inputs}); fit more runs, or measure the scatter with "
                 "replicate runs (fit --replicates)")
@@ -90,6 +90,11 @@ def error_unknown(cv: dict, gp) -> str | None:
         return (f"too few runs to know its error: its cross-validated errors are {z_rms:.1f} times the sd it states "
                 f"(at most {limit:.2f} with {n} runs)")
     return None
+
+
+def replicate_floored(gp) -> bool:
+    """Whether replicate runs floor the noise of ``gp`` above its nominal lower bound."""
+    return gp.noise_bottom() > gp.noise_bounds[0]
 
 
 def noise_at_bottom(gp) -> bool:
