@@ -154,3 +154,21 @@ def test_every_column_the_report_reads_is_recorded():
             asked |= set(re.findall(r"\"([^\"]+)\"", call))
     assert asked, "the report's modules ask a sweep for time-series columns"
     assert asked <= set(records.SERIES_COLUMNS), asked - set(records.SERIES_COLUMNS)
+
+
+def test_colonsim_sweep_resumes_in_an_unpacked_record(tmp_path, capsys):
+    """A record of three of the smoothness sweep's ten cases, unpacked: `colonsim sweep` counts them
+    done and would run the other seven (a dry run: nothing is simulated)."""
+    from colonsim.cli import main
+    from colonsim.insertion.study.sweep_spec import load_sweep
+
+    toml = ROOT / "benchmarks" / "sweeps" / "smoothness.toml"
+    spec = load_sweep(toml)
+    keys = [c.key() for c in spec.cases]
+    _sweep(tmp_path / "sweep", keys[:3])
+    (tmp_path / "sweep" / "sweep.json").write_text(json.dumps(spec.document()), encoding="utf-8")
+    records.pack(tmp_path / "sweep", tmp_path / "record")
+    records.unpack(tmp_path / "record", tmp_path / "again")
+    capsys.readouterr()
+    assert main(["sweep", str(toml), "--dry-run", "--out", str(tmp_path / "again")]) == 0
+    assert f"10 runs, 3 already in {tmp_path / 'again'}/" in capsys.readouterr().out
