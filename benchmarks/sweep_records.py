@@ -59,7 +59,8 @@ SERIES_QUANTUM = {"depth_cm": 1e-5, "deformation_cm": 1e-5, "tip_arc_cm": 1e-5, 
 SHAPE_QUANTUM = 1e-7  # m
 SERIES = "series.parquet"
 SHAPE = "shape.npz"
-SUMMARY = "summary.json"
+# a run folder's files as `colonsim sweep` writes them (colonsim.insertion.case.results.write_insertion)
+RUN_SUMMARY, RUN_SERIES, RUN_SHAPE = "summary.json", "timeseries.csv", "final_shape.npz"
 LOG = "packed.json"  # one entry per pack: when, by which code, from which folder, how many runs
 
 
@@ -169,13 +170,13 @@ def pack(sweep_dir, record_dir) -> dict:
                 continue
             run = sweep / Path(str(row["timeseries_path"])).parent if row.get("timeseries_path") else None
             if row["status"] == "ok":
-                files = [run / "summary.json", run / "timeseries.csv", run / "final_shape.npz"] if run else []
+                files = [run / RUN_SUMMARY, run / RUN_SERIES, run / RUN_SHAPE] if run else []
                 if not files or not all(f.is_file() for f in files):
                     incomplete.append(key)
                     continue
                 target = stage / key
                 target.mkdir()
-                shutil.copyfile(files[0], target / SUMMARY)
+                shutil.copyfile(files[0], target / RUN_SUMMARY)
                 series = pd.read_csv(files[1], usecols=list(SERIES_COLUMNS))
                 pack_series(series).to_parquet(target / SERIES, index=False, compression="zstd")
                 np.savez_compressed(target / SHAPE, **pack_shape(read_final_shape(run)))
@@ -200,11 +201,11 @@ def unpack(record_dir, sweep_dir) -> dict:
             if row["status"] == "ok":
                 target = stage / row["key"]
                 target.mkdir()
-                shutil.copyfile(source / SUMMARY, target / "summary.json")
-                unpack_series(pd.read_parquet(source / SERIES)).to_csv(target / "timeseries.csv", index=False)
+                shutil.copyfile(source / RUN_SUMMARY, target / RUN_SUMMARY)
+                unpack_series(pd.read_parquet(source / SERIES)).to_csv(target / RUN_SERIES, index=False)
                 with np.load(source / SHAPE, allow_pickle=False) as data:
-                    np.savez_compressed(target / "final_shape.npz", **unpack_shape({n: data[n] for n in data.files}))
-                row = {**row, "timeseries_path": f"runs/{row['key']}/timeseries.csv"}
+                    np.savez_compressed(target / RUN_SHAPE, **unpack_shape({n: data[n] for n in data.files}))
+                row = {**row, "timeseries_path": f"runs/{row['key']}/{RUN_SERIES}"}
             rows.append(row)
     _merge(record, sweep, have, rows)
     return {"unpacked": len(rows)}
