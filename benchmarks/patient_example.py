@@ -86,14 +86,14 @@ def draw_figure(folders):
     import matplotlib.pyplot as plt
     import pandas as pd
 
-    from colonsim.insertion.case.results import read_final_shape
+    from colonsim.insertion.case.results import RUN_SERIES, RUN_SUMMARY, read_final_shape
     from colonsim.insertion.case.scenario import InsertionCase, build_insertion
 
     folders = [Path(f) for f in folders]
     fig, axes = plt.subplots(len(folders), 3, figsize=(13, 4.2 * len(folders)), squeeze=False,
                              gridspec_kw={"width_ratios": [1, 1, 1.3]})
     for row, folder in zip(axes, folders):
-        summary = json.loads((folder / "summary.json").read_text())
+        summary = json.loads((folder / RUN_SUMMARY).read_text())
         case = InsertionCase(**summary["inputs"])
         model = build_insertion(case)
         shape = read_final_shape(folder)
@@ -110,7 +110,7 @@ def draw_figure(folders):
             ax.set_ylabel(f"{'xyz'[j]} [cm]")
             ax.set_title(f"{summary['scope']['name']}: {title}", fontsize=9)
         fig.colorbar(art, ax=row[1], label="wall displacement [cm]", shrink=0.8)
-        ts = pd.read_csv(folder / "timeseries.csv")
+        ts = pd.read_csv(folder / RUN_SERIES)
         row[2].plot(ts["depth_cm"], ts["deformation_cm"], "k-")
         row[2].set_xlabel("insertion depth [cm]")
         row[2].set_ylabel("colon deformation [cm]")

@@ -48,7 +48,7 @@ import pandas as pd
 
 from colonsim.errors import ColonsimError
 from colonsim.files import atomic_path, output_set, write_json
-from colonsim.insertion.case.results import read_final_shape
+from colonsim.insertion.case.results import RUN_SERIES, RUN_SHAPE, RUN_SUMMARY, read_final_shape
 from colonsim.provenance import code_version
 from colonsim.insertion.study.sweep import SWEEP_DOCUMENT, TABLE, read_results
 
@@ -59,8 +59,6 @@ SERIES_QUANTUM = {"depth_cm": 1e-5, "deformation_cm": 1e-5, "tip_arc_cm": 1e-5, 
 SHAPE_QUANTUM = 1e-7  # m
 SERIES = "series.parquet"
 SHAPE = "shape.npz"
-# a run folder's files as `colonsim sweep` writes them (colonsim.insertion.case.results.write_insertion)
-RUN_SUMMARY, RUN_SERIES, RUN_SHAPE = "summary.json", "timeseries.csv", "final_shape.npz"
 LOG = "packed.json"  # one entry per pack: when, by which code, from which folder, how many runs
 
 

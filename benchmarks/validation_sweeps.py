@@ -20,6 +20,7 @@ import pandas as pd
 
 from colonsim.catalog import scope_role
 from colonsim.errors import ColonsimError
+from colonsim.insertion.case.results import RUN_SUMMARY
 from colonsim.insertion.case.scenario import InsertionCase
 from colonsim.insertion.study.sweep import TABLE, read_results
 from colonsim.insertion.study.sweep_spec import load_sweep, parse_sweep
@@ -60,7 +61,7 @@ class Sweep:
         return self.folder / Path(str(row["timeseries_path"])).parent
 
     def summary(self, row) -> dict:
-        path = self.run_folder(row) / "summary.json"
+        path = self.run_folder(row) / RUN_SUMMARY
         return json.loads(path.read_text(encoding="utf-8")) if path.is_file() else {}
 
     def timeseries(self, row, columns=None):

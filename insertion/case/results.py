@@ -178,15 +178,19 @@ def write_vtu_series(result, folder):
             tmp.write_text("\n".join(lines) + "\n")
 
 
+# the files of a run folder, named once: the sweep, its records and the report read them by these names
+RUN_SUMMARY, RUN_SERIES, RUN_SHAPE = "summary.json", "timeseries.csv", "final_shape.npz"
+
+
 def write_insertion(result, out_dir, vtu=False) -> dict:
     """Write the files of one run into ``out_dir``; return their paths."""
     out = Path(out_dir)
-    paths = {"timeseries": out / "timeseries.csv", "summary": out / "summary.json", "plot": out / "insertion.png"}
+    paths = {"timeseries": out / RUN_SERIES, "summary": out / RUN_SUMMARY, "plot": out / "insertion.png"}
     write_csv(paths["timeseries"], user_units(result.timeseries))
     write_json(paths["summary"], result.summary)
     save_figure(insertion_figure([result]), paths["plot"])
     if getattr(result, "final_shape", None) is not None:
-        paths["final_shape"] = out / "final_shape.npz"
+        paths["final_shape"] = out / RUN_SHAPE
         with atomic_path(paths["final_shape"]) as tmp:
             np.savez_compressed(tmp, **result.final_shape)
     if vtu:
@@ -197,5 +201,5 @@ def write_insertion(result, out_dir, vtu=False) -> dict:
 
 def read_final_shape(out_dir) -> dict:
     """The final wall and scope node positions of a run folder (m), without unpickling anything."""
-    with np.load(Path(out_dir) / "final_shape.npz", allow_pickle=False) as data:
+    with np.load(Path(out_dir) / RUN_SHAPE, allow_pickle=False) as data:
         return {name: data[name] for name in data.files}

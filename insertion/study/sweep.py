@@ -34,6 +34,7 @@ import pandas as pd
 from colonsim.errors import ColonsimError
 from colonsim.files import atomic_path, check_entries, check_output_folder, output_set, write_json
 from colonsim.provenance import code_version
+from colonsim.insertion.case.results import RUN_SUMMARY
 from colonsim.insertion.case.run_budget import DEFAULT_MAX_STEPS, check_sweep_budget
 from colonsim.insertion.case.scenario import InsertionResult
 from colonsim.insertion.study.sweep_outcomes import dask_distributed, dask_outcomes, local_outcomes
@@ -225,7 +226,7 @@ def reusable_runs(folders, keys, out=None) -> dict:
         for row in read_results(folder).to_dict("records"):
             key = row["key"]
             if (key in keys and key not in found and row["status"] == "ok"
-                    and (folder / "runs" / key / "summary.json").is_file()):
+                    and (folder / "runs" / key / RUN_SUMMARY).is_file()):
                 found[key] = (folder, row)
     return found
 
