@@ -161,14 +161,15 @@ def test_too_few_runs_says_so_instead_of_a_number(train, tmp_path, capsys):
 def test_noise_at_its_bound_is_not_an_estimate():
     """Runs without scatter: the fit puts the noise at the bottom of its range, which says nothing
     about a simulation's scatter; nor does a noise at the floor replicate runs measured (one source
-    of the scatter only). A noise the fit estimated above that floor makes the error known."""
-    clean = rsj(24, seed=11, noise=0.0)
+    of the scatter only). A noise the fit estimated above that floor makes the error known (30 runs:
+    10 per input, so that the runs-per-input rule does not speak first)."""
+    clean = rsj(30, seed=11, noise=0.0)
     model = SweepSurrogate(targets=(TARGET,), n_restarts=1).fit(clean)
     assert "bottom of its range" in model.error_unknown("rsj", TARGET)
     at_floor = SweepSurrogate(targets=(TARGET,), n_restarts=1,
                               replicates=replicates_of(clean, 8, seed=3, noise=0.01)).fit(clean)
     assert "at the floor the replicate runs measured" in at_floor.error_unknown("rsj", TARGET)
-    noisy = rsj(24, seed=11)  # scatter NOISE = 0.05 cm, of which the replicates see 0.01 cm
+    noisy = rsj(30, seed=11)  # scatter NOISE = 0.05 cm, of which the replicates see 0.01 cm
     measured = SweepSurrogate(targets=(TARGET,), n_restarts=1,
                               replicates=replicates_of(noisy, 8, seed=3, noise=0.01, shared=True)).fit(noisy)
     assert measured.models_["rsj"][TARGET].noise_std > 2 * measured.scatter_["rsj"][TARGET]["sd"]
@@ -184,22 +185,28 @@ def test_cross_validated_errors_larger_than_the_sd_make_the_error_unknown(known)
     assert "1.6 times the sd it states (at most 1.21 with 30 runs)" in error_unknown({**cv, "z_rms": 1.6}, gp)
 
 
-def test_without_replicate_runs_ten_runs_per_input_are_needed(known, train):
-    """Without replicate runs a model of fewer than 10 runs per input says its error is unknown, even
-    where its noise was estimated and its cross-validated errors agree with its sd; from 10 per
-    input, or with replicate runs, that rule does not silence it."""
+def test_ten_runs_per_input_are_needed(known, train):
+    """A model of fewer than 10 runs per input says its error is unknown, even where its noise was
+    estimated and its cross-validated errors agree with its sd, with replicate runs or without (a
+    noise above the replicates' floor is no sign that the fit separated scatter from trend); from 10
+    per input that rule does not silence it."""
     from colonsim.surrogate.validation import MIN_RUNS_PER_INPUT, error_unknown
 
     assert MIN_RUNS_PER_INPUT == 10
     small = SweepSurrogate(targets=(TARGET,), n_restarts=1).fit(known.iloc[:29])
     gp, cv = small.models_["rsj"][TARGET], small.cv_["rsj"][TARGET]
     assert gp.noise_level_ > 1.05 * gp.noise_bottom() and cv["z_rms"] < 1.3  # no other check would catch it
-    assert error_unknown(cv, gp) == ("too few runs to know its error without replicate runs (29 < 10 per input, 30 for "
-                                     "its 3); fit more runs, or measure the scatter with replicate runs (fit --replicates)")
+    assert error_unknown(cv, gp) == "too few runs to know its error (29 < 10 per input, 30 for its 3); fit more runs"
     assert SweepSurrogate(targets=(TARGET,), n_restarts=1).fit(known).error_unknown("rsj", TARGET) is None
     measured = SweepSurrogate(targets=(TARGET,), n_restarts=1,
                               replicates=replicates_of(train, 8, seed=3, noise=0.01, shared=True)).fit(train)
-    assert "without replicate runs" not in (measured.error_unknown("rsj", TARGET) or "")
+    gp = measured.models_["rsj"][TARGET]
+    assert gp.noise_level_ > 1.05 * gp.noise_bottom()  # above the replicates' floor: no other check would catch it
+    assert measured.error_unknown("rsj", TARGET) == ("too few runs to know its error (24 < 10 per input, 30 for its "
+                                                     "3); fit more runs")
+    enough = SweepSurrogate(targets=(TARGET,), n_restarts=1,
+                            replicates=replicates_of(known, 8, seed=3, noise=0.01, shared=True)).fit(known)
+    assert enough.error_unknown("rsj", TARGET) is None
 
 
 def test_fit_with_replicates_on_the_command_line(train, tmp_path, capsys):
