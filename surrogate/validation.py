@@ -74,18 +74,20 @@ def error_unknown(cv: dict, gp) -> str | None:
         return "its error was not cross-checked (a model of an older colonsim); refit it"
     if n < MIN_CHECKED_RUNS:
         return f"too few runs to know its error ({n} < {MIN_CHECKED_RUNS})"
-    collapsed = [p for p in getattr(gp, "parts", (gp,)) if noise_at_bottom(p)]  # a LargerOf: either part
+    parts = getattr(gp, "parts", (gp,))  # a LargerOf: either part
+    inputs = int(parts[0].X_train_.shape[1])
+    needed = MIN_RUNS_PER_INPUT * inputs
+    collapsed = [p for p in parts if noise_at_bottom(p)]
     if any(not replicate_floored(p) for p in collapsed):  # at the nominal bound, not a floor
+        more = f" and fit at least {needed} runs" if n < needed else ""
         return ("too few runs to know its error: the fit put the run-to-run scatter at the bottom of its range instead "
-                "of estimating it; measure it with replicate runs (fit --replicates)")
+                f"of estimating it; measure it with replicate runs (fit --replicates){more}")
     if collapsed:
         return ("too few runs to know its error: the fit put the run-to-run scatter at the floor the replicate runs "
                 "measured instead of estimating it, and that floor is only part of the scatter; fit more runs")
-    parts = getattr(gp, "parts", (gp,))
-    inputs = int(parts[0].X_train_.shape[1])
-    if n < MIN_RUNS_PER_INPUT * inputs:
+    if n < needed:
         return (f"too few runs to know its error ({n} < {MIN_RUNS_PER_INPUT} per input, "
-                f"{MIN_RUNS_PER_INPUT * inputs} for its {inputs}); fit more runs")
+                f"{needed} for its {inputs}); fit more runs")
     limit = float(np.sqrt(chi2.ppf(0.95, n) / n))
     if z_rms > limit:
         return (f"too few runs to know its error: its cross-validated errors are {z_rms:.1f} times the sd it states "

@@ -165,7 +165,10 @@ def test_noise_at_its_bound_is_not_an_estimate():
     10 per input, so that the runs-per-input rule does not speak first)."""
     clean = rsj(30, seed=11, noise=0.0)
     model = SweepSurrogate(targets=(TARGET,), n_restarts=1).fit(clean)
-    assert "bottom of its range" in model.error_unknown("rsj", TARGET)
+    assert model.error_unknown("rsj", TARGET).endswith("bottom of its range instead of estimating it; measure it "
+                                                       "with replicate runs (fit --replicates)")
+    few = SweepSurrogate(targets=(TARGET,), n_restarts=1).fit(clean.iloc[:24])  # replicates alone would not do
+    assert few.error_unknown("rsj", TARGET).endswith("(fit --replicates) and fit at least 30 runs")
     at_floor = SweepSurrogate(targets=(TARGET,), n_restarts=1,
                               replicates=replicates_of(clean, 8, seed=3, noise=0.01)).fit(clean)
     assert "at the floor the replicate runs measured" in at_floor.error_unknown("rsj", TARGET)
