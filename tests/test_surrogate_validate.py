@@ -193,18 +193,19 @@ def test_ten_runs_per_input_are_needed(known, train):
     estimated and its cross-validated errors agree with its sd, with replicate runs or without (a
     noise above the replicates' floor is no sign that the fit separated scatter from trend); from 10
     per input that rule does not silence it."""
-    from colonsim.surrogate.validation import MIN_RUNS_PER_INPUT, error_unknown
+    from colonsim.surrogate.validation import MIN_RUNS_PER_INPUT, NOISE_AT_BOUND, error_unknown
 
     assert MIN_RUNS_PER_INPUT == 10
     small = SweepSurrogate(targets=(TARGET,), n_restarts=1).fit(known.iloc[:29])
     gp, cv = small.models_["rsj"][TARGET], small.cv_["rsj"][TARGET]
-    assert gp.noise_level_ > 1.05 * gp.noise_bottom() and cv["z_rms"] < 1.3  # no other check would catch it
+    assert gp.noise_level_ > NOISE_AT_BOUND * gp.noise_bottom() and cv["z_rms"] < 1.3  # no other check would catch it
     assert error_unknown(cv, gp) == "too few runs to know its error (29 < 10 per input, 30 for its 3); fit more runs"
     assert SweepSurrogate(targets=(TARGET,), n_restarts=1).fit(known).error_unknown("rsj", TARGET) is None
     measured = SweepSurrogate(targets=(TARGET,), n_restarts=1,
                               replicates=replicates_of(train, 8, seed=3, noise=0.01, shared=True)).fit(train)
-    gp = measured.models_["rsj"][TARGET]
-    assert gp.noise_level_ > 1.05 * gp.noise_bottom()  # above the replicates' floor: no other check would catch it
+    gp, cv = measured.models_["rsj"][TARGET], measured.cv_["rsj"][TARGET]
+    assert gp.noise_level_ > NOISE_AT_BOUND * gp.noise_bottom() and cv["z_rms"] < 1.2  # above the replicates'
+    # floor and within the chi-square limit (1.23 for 24 runs): no other check would catch it
     assert measured.error_unknown("rsj", TARGET) == ("too few runs to know its error (24 < 10 per input, 30 for its "
                                                      "3); fit more runs")
     enough = SweepSurrogate(targets=(TARGET,), n_restarts=1,
