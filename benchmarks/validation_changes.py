@@ -191,7 +191,8 @@ def markdown(section) -> list:
         return lines + [f"{NOT_RUN}: {(section or {}).get('note', '')}", ""]
     p = section["previous"]
     n_resisted = sum(r.get("sweep") == "resistance" for r in section["runs"])
-    code = "; ".join(f"{k}: " + ", ".join(f"`{c[:12]}`" for c in (v or {})) for k, v in p["sweeps"].items())
+    code = "; ".join(f"{k}: " + (", ".join(f"`{c[:12]}`" for c in v) if v else "not run there (its sections carried)")
+                     for k, v in p["sweeps"].items())
     lines += [f"Against the report of {p['date']} (commit `{(p['commit'] or '')[:12]}`; sweeps' code {code}). "
               "Runs are matched by model, scope and inputs. A quantity has moved when it changed by "
               f"{100 * MOVED:g} % or more (deformations below {SMALL_CM:g} cm: by {MOVED_CM:g} cm or more, shown as the "
