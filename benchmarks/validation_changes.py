@@ -100,7 +100,7 @@ def _verdicts(previous, current):
 
     def count(d):
         return {name: (sum(bool(q.get("passed")) for k, q in d.items() if k[0] == name),
-                       sum(1 for k in d if k[0] == name))
+                       sum(1 for k, q in d.items() if k[0] == name and q.get("passed") is not None))
                 for name in ("rate", "mesh", "rate (other angles)", RESISTED_RATE)}
 
     return flips, count(old), count(new)
@@ -211,7 +211,7 @@ def markdown(section) -> list:
             lines += [md_table(group, [("run", "run")] + [
                 (n, (lambda i: lambda r: _cell(r["quantities"][i]))(i)) for i, n in enumerate(names)]), ""]
     before, after = section["pair_counts"]["before"], section["pair_counts"]["after"]
-    lines += ["Pass counts of the pair checks (passed / compared quantities): " + "; ".join(
+    lines += ["Pass counts of the pair checks (passed / compared quantities; one below its floor is not compared): " + "; ".join(
         f"{name} {before[name][0]}/{before[name][1]} -> {after[name][0]}/{after[name][1]}" for name in after) + ".", ""]
     if section["flips"]:
         lines += [md_table(section["flips"], [("check", "check"), ("run", "run"), ("quantity", "quantity"),

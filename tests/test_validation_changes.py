@@ -100,3 +100,11 @@ def test_the_code_of_each_previous_sweep_is_named_and_a_sweep_it_did_not_run_is_
     text = "\n".join(changes.markdown(changes.changes(before, after)))
     assert f"main: `{'a' * 12}`" in text
     assert "resistance: not run there (its sections carried)" in text and "resistance: ;" not in text
+
+
+def test_a_quantity_below_its_floor_is_not_counted_as_compared():
+    before, after = report(0.96, 1.83, 0.071, "86cc17389552"), report(1.54, 1.834, 0.002, "0f0f0f0f0f0f")
+    for doc in (before, after):
+        doc["rate_check"]["rows"][0]["quantities"].append({"quantity": "max", "change": None, "passed": None})
+    counts = changes.changes(before, after)["pair_counts"]
+    assert counts["before"]["rate"] == (0, 1) and counts["after"]["rate"] == (1, 1)
