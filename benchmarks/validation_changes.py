@@ -99,9 +99,12 @@ def _verdicts(previous, current):
              for k in new if k in old and old[k].get("passed") != new[k].get("passed")]
 
     def count(d):
-        return {name: (sum(bool(q.get("passed")) for k, q in d.items() if k[0] == name),
-                       sum(1 for k, q in d.items() if k[0] == name and q.get("passed") is not None))
-                for name in ("rate", "mesh", "rate (other angles)", RESISTED_RATE)}
+        """(passed, compared) per check; a quantity below its floor has no verdict and is not compared."""
+        counts = {}
+        for name in ("rate", "mesh", "rate (other angles)", RESISTED_RATE):
+            verdicts = [q["passed"] for k, q in d.items() if k[0] == name and q.get("passed") is not None]
+            counts[name] = (sum(map(bool, verdicts)), len(verdicts))
+        return counts
 
     return flips, count(old), count(new)
 
@@ -165,7 +168,8 @@ def changes(previous: dict | None, current: dict) -> dict:
     flips, counts_before, counts_after = _verdicts(previous, current)
     header = previous.get("header", {})
     return {"ran": True, "previous": {"date": header.get("date"), "commit": header.get("commit"),
-                                      "sweeps": {k: v.get("code") for k, v in header.get("sweeps", {}).items()}},
+                                      "sweeps": {k: v.get("code") for k, v in header.get("sweeps", {}).items()},
+                                      "carried": header.get("carried") or []},
             "runs": runs, "moved": [r for r in runs if any(q["moved"] for q in r["quantities"])],
             "flips": flips, "claim_flips": _claim_flips(previous, current),
             "carried": (current.get("header") or {}).get("carried") or [],
@@ -191,8 +195,10 @@ def markdown(section) -> list:
         return lines + [f"{NOT_RUN}: {(section or {}).get('note', '')}", ""]
     p = section["previous"]
     n_resisted = sum(r.get("sweep") == "resistance" for r in section["runs"])
-    code = "; ".join(f"{k}: " + (", ".join(f"`{c[:12]}`" for c in v) if v else "not run there (its sections carried)")
+    code = "; ".join(f"{k}: " + (", ".join(f"`{c[:12]}`" for c in v) if v else "not run there")
                      for k, v in p["sweeps"].items())
+    if p.get("carried"):
+        code += f"; sections it carried from an earlier report: {', '.join(p['carried'])}"
     lines += [f"Against the report of {p['date']} (commit `{(p['commit'] or '')[:12]}`; sweeps' code {code}). "
               "Runs are matched by model, scope and inputs. A quantity has moved when it changed by "
               f"{100 * MOVED:g} % or more (deformations below {SMALL_CM:g} cm: by {MOVED_CM:g} cm or more, shown as the "

@@ -94,12 +94,15 @@ def test_a_claim_whose_verdict_flipped_is_listed_and_counted_and_an_unchanged_on
     assert changes.changes(before, before)["claim_flips"] == []
 
 
-def test_the_code_of_each_previous_sweep_is_named_and_a_sweep_it_did_not_run_is_said_to_be_carried():
+def test_each_previous_sweep_is_named_with_its_code_or_as_not_run_and_its_carried_sections_are_named():
     before, after = report(0.96, 1.83, 0.071, "86cc17389552"), report(1.54, 1.834, 0.002, "0f0f0f0f0f0f")
     before["header"]["sweeps"] = {"main": {"code": {"a" * 40: 39}}, "resistance": {"code": {}}}
     text = "\n".join(changes.markdown(changes.changes(before, after)))
     assert f"main: `{'a' * 12}`" in text
-    assert "resistance: not run there (its sections carried)" in text and "resistance: ;" not in text
+    assert "resistance: not run there)" in text and "resistance: ;" not in text and "carried" not in text
+    before["header"]["carried"] = ["resistance"]
+    text = "\n".join(changes.markdown(changes.changes(before, after)))
+    assert "resistance: not run there; sections it carried from an earlier report: resistance)" in text
 
 
 def test_a_quantity_below_its_floor_is_not_counted_as_compared():
