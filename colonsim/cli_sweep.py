@@ -132,7 +132,9 @@ def cmd_sweep(args):
         check_sweep_budget(spec.cases, args.max_steps)
         store = SweepStore(out)
         store.load()
-        store.check_same_sweep([c.key() for c in spec.cases], spec.source)
+        extends = store.check_same_sweep([c.key() for c in spec.cases], spec.source)
+        if extends:
+            print(extends)
         done = store.finished(args.retry_failed)
         pending = {c.key() for c in spec.cases} - done
         reused = len(reusable_runs(args.reuse, pending, out)) if args.reuse else 0

@@ -235,6 +235,30 @@ def test_a_folder_holds_one_sweep(tmp_path):
             store.check_same_sweep([a.cases[0].key()])  # a part of it is another sweep too
 
 
+def test_a_longer_sweep_extends_the_one_a_folder_holds(tmp_path):
+    """A sweep that holds every case of the folder's sweep and more resumes there, and says so;
+    not if the folder has a row that is not one of its cases."""
+    from colonsim.errors import ColonsimError
+    from colonsim.insertion.study.sweep_spec import parse_sweep
+
+    a = parse_sweep('[sweep]\nname = "a"\n[[grid]]\nsegment = "straight"\nscope = ["utc", "sdc"]\n')
+    longer = parse_sweep('[sweep]\nname = "longer"\n[[grid]]\nsegment = "straight"\nscope = ["utc", "pdc", "sdc"]\n')
+    other = parse_sweep('[sweep]\nname = "other"\n[[grid]]\nsegment = "straight"\nscope = ["pdc", "sdc"]\n')
+    outcome = {"status": "failed", "error": "x", "wall_time_s": 1.0, "finished_at": "2026-01-01T00:00:00+00:00"}
+    (tmp_path / "sweep.json").write_text(__import__("json").dumps(a.document()))
+    with SweepStore(tmp_path) as store:
+        store.record(a.cases[0], {**outcome, "key": a.cases[0].key()})
+        said = store.check_same_sweep([c.key() for c in longer.cases], longer.source)
+        assert said == (f"this sweep of 3 runs extends the one {tmp_path} held ('a'), whose 2 runs are all cases "
+                        "of it (1 recorded, kept)")
+        assert store.check_same_sweep([c.key() for c in a.cases], a.source) is None  # the same sweep
+        with pytest.raises(ColonsimError, match=r"holds another sweep \('a'\) of 2 runs \(1 recorded, 1 in common"):
+            store.check_same_sweep([c.key() for c in other.cases], other.source)  # not every case of 'a'
+        store.record(longer.cases[1], {**outcome, "key": longer.cases[1].key()})  # a row 'a' does not have
+        with pytest.raises(ColonsimError, match="another sweep"):
+            store.check_same_sweep([c.key() for c in a.cases] + ["a third key"])  # longer, but without that row
+
+
 def test_an_unreachable_scheduler_fails_before_anything_is_written(tmp_path):
     pytest.importorskip("distributed")  # the cluster extra
     import socket

@@ -95,11 +95,14 @@ class SweepStore:
             self._lock = None
 
     def check_same_sweep(self, keys, source=None):
-        """Refuse to resume here a sweep other than the one this folder holds.
+        """Refuse to resume here a sweep other than the one this folder holds; return None, or a
+        line saying that this sweep extends the one held.
 
         The same sweep: the same cases (keys), or the same TOML text (its keys change when the
-        case fields change with the code). A folder without ``sweep.json`` holds the rows of its
-        table: every one must be a case of this sweep."""
+        case fields change with the code). An extension: every case of the sweep held is a case of
+        this one (a longer list, the finished runs kept); ``sweep.json`` then names this sweep.
+        A folder without ``sweep.json`` holds the rows of its table: every one must be a case of
+        this sweep."""
         keys = set(keys)
         path = self.folder / SWEEP_DOCUMENT
         if path.is_file():
@@ -112,12 +115,16 @@ class SweepStore:
                 raise ColonsimError(f"cannot read {path} ({type(exc).__name__}); it should name the sweep this folder "
                                     "holds: use another --out") from None
             if held_keys == keys or (source and held_source == source):
-                return
+                return None
             name = held.get("name")
+            if held_keys < keys and set(self.rows) <= keys:
+                return (f"this sweep of {len(keys)} runs extends the one {self.folder} held"
+                        f"{f' ({name!r})' if name else ''}, whose {len(held_keys)} runs are all cases of it "
+                        f"({len(self.rows)} recorded, kept)")
         else:
             held_keys, name = set(self.rows), None
             if held_keys <= keys:
-                return
+                return None
         common = len(held_keys & keys)
         raise ColonsimError(f"{self.folder} holds another sweep{f' ({name!r})' if name else ''} of {len(held_keys)} "
                             f"runs ({len(self.rows)} recorded, {common} in common with this one of {len(keys)}); "
@@ -273,7 +280,9 @@ def run_sweep(cases, out, workers=2, scheduler=None, runner=None, retry_failed=F
     check_sweep_budget(cases, max_steps)
     t0 = time.perf_counter()
     with SweepStore(out) as store:
-        store.check_same_sweep([c.key() for c in cases], spec.source if spec is not None else None)
+        extends = store.check_same_sweep([c.key() for c in cases], spec.source if spec is not None else None)
+        if extends:
+            log(extends)
         done = store.finished(retry_failed)
         todo = [c for c in cases if c.key() not in done]
         if reuse:
