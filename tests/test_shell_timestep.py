@@ -77,6 +77,8 @@ def test_time_step_is_stable_and_not_overly_conservative(state, serial_kernels):
     dt = shell.critical_time_step(x)
     exact = _exact_time_step(shell, x)
     assert 0.4 * exact < dt <= exact
+    membrane, hinges = shell.frequency_bounds(x)  # the two parts of the bound (benchmarks/bench_time_step.py)
+    assert dt == 2.0 / np.sqrt(membrane + hinges) and 0.0 < hinges < membrane
 
 
 @pytest.mark.parametrize("name", ["mooney_rivlin_2", "neo_hookean", "yeoh"])
@@ -93,6 +95,8 @@ def test_time_step_is_stable_for_every_law(name, state, serial_kernels):
     dt = shell.critical_time_step(x)
     exact = _exact_time_step(shell, x)
     assert 0.4 * exact < dt <= exact
+    membrane, hinges = shell.frequency_bounds(x)  # the two parts of the bound (benchmarks/bench_time_step.py)
+    assert dt == 2.0 / np.sqrt(membrane + hinges) and 0.0 < hinges < membrane
 
 
 def test_mass_scaling_lengthens_time_step():

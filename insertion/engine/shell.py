@@ -366,12 +366,10 @@ class Shell:
         norm = np.linalg.norm(normals, axis=1)
         return normals / np.where(norm > 0.0, norm, 1.0)[:, None]
 
-    def critical_time_step(self, x):
-        """Conservative stable central-difference time step at configuration x, s.
-
-        2 / omega_max with omega_max^2 <= (membrane element bound at the current stretches)
-        + (Gershgorin bound of the hinge stiffness), both with the current nodal masses.
-        """
+    def frequency_bounds(self, x):
+        """The two bounds of the squared frequencies at configuration x, rad^2/s^2: the membrane's
+        element bound (at the current stretches) and the Gershgorin bound of the hinge stiffness,
+        both with the current nodal masses."""
         self._check_x(x)
         # The solver may replace or rescale self.mass (mass scaling); the membrane bound needs the
         # per-node scaling factor relative to the physical lumped mass.
@@ -381,13 +379,23 @@ class Shell:
             x, self.triangles, self.dm_inv, self.thickness, self.density, self._law, self._law_params, scale,
             self._omega2,
         )
-        omega2 = float(self._omega2.max())
-        if len(self.hinges):
-            hinge_rowsum_kernel(x, self.hinges, self.hinge_stiffness, self.theta0, self._hinge_buf)
-            rows = self._node_tmp
-            rows[:] = 0.0
-            gather(self._hinge_buf, self._hinge_ptr, self._hinge_slots, rows)
-            omega2 += max_row_over_mass(rows, self.mass)
+        membrane = float(self._omega2.max())
+        if not len(self.hinges):
+            return membrane, 0.0
+        hinge_rowsum_kernel(x, self.hinges, self.hinge_stiffness, self.theta0, self._hinge_buf)
+        rows = self._node_tmp
+        rows[:] = 0.0
+        gather(self._hinge_buf, self._hinge_ptr, self._hinge_slots, rows)
+        return membrane, max_row_over_mass(rows, self.mass)
+
+    def critical_time_step(self, x):
+        """Conservative stable central-difference time step at configuration x, s.
+
+        2 / omega_max with omega_max^2 <= (membrane element bound at the current stretches)
+        + (Gershgorin bound of the hinge stiffness): :meth:`frequency_bounds`.
+        """
+        membrane, hinges = self.frequency_bounds(x)
+        omega2 = membrane + hinges
         if not np.isfinite(omega2):
             raise ColonsimError(
                 f"wall of '{self.name}' has an inverted or collapsed triangle; no stable time step exists."
