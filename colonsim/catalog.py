@@ -365,6 +365,8 @@ COLUMNS = {c.name: c for c in (
     Column("scope_axial_damping_s", _S, "s", "Kelvin-Voigt damping time of the scope's axial springs"),
     Column("record_interval_s", _S, "s", "simulated time between recorded samples"),
     Column("time_step_factor", _S, "", "safety factor on the stable time step"),
+    Column("time_step_estimate", _S, "", "what the stable time step rests on: bounds (default) or global (power "
+                                         "iteration on the coupled system)"),
     Column("final_deformation_cm", _O, "cm", "colon deformation at the end of the run", DEFAULT_TARGET,
            "final colon deformation [cm]"),
     Column("max_deformation_cm", _O, "cm", "largest colon deformation during the run", DEFAULT_TARGET,

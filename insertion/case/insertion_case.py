@@ -22,7 +22,10 @@ from colonsim.insertion.anatomy.scopes import colonoscope
 from colonsim.insertion.case.case_material import case_material
 
 # cases that do not use them stay what they were (existing sweep folders resume).
-LATER_FIELDS = ("centerline", "centerline_smoothing_mm", "material_parameters", "failure_stretch")
+LATER_FIELDS = ("centerline", "centerline_smoothing_mm", "material_parameters", "failure_stretch",
+                "time_step_estimate")
+# how the stable time step is estimated (docs/model.md, "The global time-step estimate")
+TIME_STEP_ESTIMATES = ("bounds", "global")
 # fields left out of the key at the value that gives the runs of before they existed
 ABSENT_AT = {"distal_resistance_N": 0.0, "held_push_share": 1.0, "held_push_lead_mm": 0.0, "relax_max_s": 0.0}
 
@@ -114,6 +117,10 @@ class InsertionCase:
         Simulated time between recorded samples.
     time_step_factor : float
         Safety factor on the stable time step.
+    time_step_estimate : str
+        "bounds" (element and Gershgorin bounds, the default) or "global" (the coupled system's
+        largest frequency by power iteration, never a shorter step than the bounds'; docs/model.md,
+        "The global time-step estimate").
     material_parameters : dict or None
         {name: Pa} replacing the parameters of ``material`` (its law stays); set by a sweep's
         ``[material]`` section (:mod:`colonsim.insertion.study.material_samples`). None = the file's.
@@ -152,6 +159,7 @@ class InsertionCase:
     record_interval_s: float = 1e-3
     time_step_factor: float = 0.9
     material_parameters: dict | None = None
+    time_step_estimate: str = "bounds"
 
     def validate(self):
         """Raise :class:`ColonsimError` naming the first bad input and its fix."""
@@ -195,6 +203,9 @@ class InsertionCase:
         for name, value, lo, hi, what in checks:
             if not (isinstance(value, (int, float)) and math.isfinite(value) and lo <= value <= hi):
                 raise ColonsimError(f"{name} = {value!r} is outside [{lo:g}, {hi:g}]; give the {what}")
+        if self.time_step_estimate not in TIME_STEP_ESTIMATES:
+            raise ColonsimError(f"time_step_estimate = {self.time_step_estimate!r} is not one of "
+                                f"{', '.join(TIME_STEP_ESTIMATES)}; give \"bounds\" (the default) or \"global\"")
         if 0.0 < self.relax_max_s < self.relax_s:
             raise ColonsimError(f"relax_max_s = {self.relax_max_s:g} s is shorter than relax_s = {self.relax_s:g} s; "
                                 "give at least relax_s, or 0 for a relax of relax_s")

@@ -58,6 +58,7 @@ from colonsim.insertion.case.recording import InsertionRecorder
 from colonsim.insertion.case.run_summary import end_state, summarize, tip_passed_end
 from colonsim.insertion.engine.constraints import FixedNodes, LineConstraint, PrescribedVelocity
 from colonsim.insertion.engine.contact import RodShellContact
+from colonsim.insertion.engine.global_time_step import GlobalTimeStep
 from colonsim.insertion.engine.sheath_lip import SheathLip
 from colonsim.insertion.engine.shell import Shell
 from colonsim.insertion.engine.solver import ExplicitSolver
@@ -181,7 +182,8 @@ def build_insertion(case: InsertionCase) -> Insertion:
                                    engagement=0.0)
     solver = ExplicitSolver([rod, shell], contacts=[contact, lip], constraints=constraints,
                             damping={rod.name: case.scope_damping, "colon": case.colon_damping},
-                            time_step_factor=case.time_step_factor, resistances=[resistance] if resistance else [])
+                            time_step_factor=case.time_step_factor, resistances=[resistance] if resistance else [],
+                            global_estimate=GlobalTimeStep() if case.time_step_estimate == "global" else None)
     return Insertion(case, geometry, shell, rod, scope, contact, push, solver, drive, entry, axis, mobile, held,
                      total_depth, tip_end, resistance)
 

@@ -32,8 +32,8 @@ import numpy as np
 from colonsim.errors import ColonsimError
 from colonsim.insertion.engine.contact_broad_phase import (candidate_counts, candidate_fill, max_displacement,
                                                            segment_cell_table)
-from colonsim.insertion.engine.contact_kernel import (contact_kernel, contact_kernel_serial, dissipation_rates,
-                                                      rod_reactions)
+from colonsim.insertion.engine.contact_kernel import (contact_kernel, contact_kernel_serial, contact_spring_action,
+                                                      dissipation_rates, rod_reactions)
 
 
 class RodShellContact:
@@ -243,6 +243,18 @@ class RodShellContact:
         rod_w2 = max(2.0 * self._rod_weight, 4.0 * self.held_stiffness / float(self.rod.mass.min()))
         return {self.shell.name: self.stiffness / float(self.shell.mass.min()) / reduction,
                 self.rod.name: rod_w2 / reduction}
+
+    def spring_action(self, state, u, ku):
+        """Add K u of the penalty springs active at the last evaluation into ``ku`` (per body
+        name, (n, 3) arrays; ``u`` the displacements), each counted as k / r^2 for its damping
+        (:meth:`damping_reduction`), as the bounds count it
+        (:class:`colonsim.insertion.engine.global_time_step.GlobalTimeStep`)."""
+        if len(self._nodes) == 0:
+            return
+        s = state[self.shell.name]
+        contact_spring_action(s.x, state[self.rod.name].x, self.rod.segments, self._nodes, self._rod_seg, self._rod_t,
+                              self._rod_k, s.fixed, self._held_normal, 1.0 / self.damping_reduction() ** 2,
+                              u[self.shell.name], u[self.rod.name], ku[self.shell.name], ku[self.rod.name])
 
     def damping_reduction(self):
         """Factor sqrt(1 + zeta^2) - zeta on the stable step of a damped spring (damping force from

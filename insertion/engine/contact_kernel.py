@@ -1,6 +1,7 @@
 """Narrow phase of the rod-shell contact: penalty, damping and friction forces per candidate pair
 (the law is in :mod:`colonsim.insertion.engine.contact`'s docstring), the power they dissipate,
-and the reactions split onto the rod nodes.
+and the reactions split onto the rod nodes; the active springs' stiffness times a displacement,
+for the global time-step estimate (:mod:`colonsim.insertion.engine.global_time_step`).
 
 The force kernel is one source compiled threaded and serial (:mod:`._compile`).
 """
@@ -146,6 +147,15 @@ def _contact_forces(xs, vs, ms, fixed_s, held_n, xr, vr, mr, seg, nodes, ptr, ca
 contact_kernel, contact_kernel_serial = threaded_and_serial(_contact_forces)
 
 
+@numba.njit(cache=True, inline="always")
+def _active_pair(c, seg, nodes, rod_seg, rod_t):
+    """(in contact, wall node, segment's first and second node, fraction t along it) of candidate c."""
+    s = rod_seg[c]
+    if s < 0:
+        return False, 0, 0, 0, 0.0
+    return True, nodes[c], seg[s, 0], seg[s, 1], rod_t[c]
+
+
 @numba.njit(cache=True)
 def dissipation_rates(vs, vr, seg, nodes, rod_seg, rod_t, damp_f, fric_f):
     """Power (W, >= 0) taken out by the stored damping and friction forces at velocities vs, vr
@@ -153,13 +163,9 @@ def dissipation_rates(vs, vr, seg, nodes, rod_seg, rod_t, damp_f, fric_f):
     p_damp = 0.0
     p_fric = 0.0
     for c in range(nodes.shape[0]):
-        s = rod_seg[c]
-        if s < 0:
+        active, i, a, b, t = _active_pair(c, seg, nodes, rod_seg, rod_t)
+        if not active:
             continue
-        i = nodes[c]
-        a = seg[s, 0]
-        b = seg[s, 1]
-        t = rod_t[c]
         for k in range(3):
             u = vs[i, k] - ((1.0 - t) * vr[a, k] + t * vr[b, k])
             p_damp -= damp_f[c, k] * u
@@ -196,3 +202,52 @@ def rod_reactions(seg, rod_seg, rod_t, rod_k, rod_f, mr, fr, load):
     for j in range(load.shape[0]):
         worst = max(worst, load[j] / mr[j])
     return t0, t1, t2, worst
+
+
+@numba.njit(cache=True)
+def contact_spring_action(xs, xr, seg, nodes, rod_seg, rod_t, rod_k, fixed_s, held_n, scale, us, ur, out_s, out_r):
+    """Add the active penalty springs' K u into ``out_s`` (wall) and ``out_r`` (scope): for
+    candidate c in contact (``rod_seg[c]`` >= 0), wall node i, the scope point p = (1 - t) x_a + t x_b,
+    the normal n from p to the node (a held node's rest normal ``held_n[i]`` when it is nonzero),
+    the relative displacement d = u_i - ((1 - t) u_a + t u_b) (u_i = 0 for a held node) and the
+    spring force ``scale * k (n . d) n``, split linearly onto the segment's nodes."""
+    for c in range(nodes.shape[0]):
+        active, i, a, b, t = _active_pair(c, seg, nodes, rod_seg, rod_t)
+        if not active:
+            continue
+        held = fixed_s[i] != 0
+        n0 = 0.0
+        n1 = 0.0
+        n2 = 0.0
+        if held and (held_n[i, 0] != 0.0 or held_n[i, 1] != 0.0 or held_n[i, 2] != 0.0):
+            n0 = held_n[i, 0]
+            n1 = held_n[i, 1]
+            n2 = held_n[i, 2]
+        else:
+            n0 = xs[i, 0] - ((1.0 - t) * xr[a, 0] + t * xr[b, 0])
+            n1 = xs[i, 1] - ((1.0 - t) * xr[a, 1] + t * xr[b, 1])
+            n2 = xs[i, 2] - ((1.0 - t) * xr[a, 2] + t * xr[b, 2])
+            norm = math.sqrt(n0 * n0 + n1 * n1 + n2 * n2)
+            if norm == 0.0:
+                continue
+            n0 /= norm
+            n1 /= norm
+            n2 /= norm
+        d0 = -((1.0 - t) * ur[a, 0] + t * ur[b, 0])
+        d1 = -((1.0 - t) * ur[a, 1] + t * ur[b, 1])
+        d2 = -((1.0 - t) * ur[a, 2] + t * ur[b, 2])
+        if not held:
+            d0 += us[i, 0]
+            d1 += us[i, 1]
+            d2 += us[i, 2]
+        g = scale * rod_k[c] * (n0 * d0 + n1 * d1 + n2 * d2)
+        if not held:
+            out_s[i, 0] += g * n0
+            out_s[i, 1] += g * n1
+            out_s[i, 2] += g * n2
+        out_r[a, 0] -= (1.0 - t) * g * n0
+        out_r[a, 1] -= (1.0 - t) * g * n1
+        out_r[a, 2] -= (1.0 - t) * g * n2
+        out_r[b, 0] -= t * g * n0
+        out_r[b, 1] -= t * g * n1
+        out_r[b, 2] -= t * g * n2

@@ -129,6 +129,21 @@ class SheathLip:
         vp = (1.0 - t) * r.v[e] + t * r.v[e + 1]
         self.dissipated += 0.5 * (self._out[9] - float(self._out[6:9] @ vp)) * dt
 
+    def spring_action(self, state, u, ku):
+        """Add K u of the lip's spring (across the axis, k / r^2 for its damping, as
+        :meth:`frequency_squared` counts it) into ``ku[rod name]``."""
+        e = int(self._out[0])
+        if e < 0:
+            return
+        t = self._out[1]
+        ur = u[self.rod.name]
+        d = (1.0 - t) * ur[e] + t * ur[e + 1]
+        z = self.damping_ratio
+        force = self.stiffness / (math.sqrt(1.0 + z * z) - z) ** 2 * (d - (d @ self.direction) * self.direction)
+        out = ku[self.rod.name]
+        out[e] += (1.0 - t) * force
+        out[e + 1] += t * force
+
     def record(self):
         return {"energy": self.energy, "dissipated": self.dissipated, "lip_force": self.force.copy()}
 

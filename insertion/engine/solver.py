@@ -100,11 +100,16 @@ class ExplicitSolver:
     parallel_min_nodes : int
         Bodies with at least this many nodes get threaded nodal updates (smaller ones run
         serially: starting threads costs more than the work, and much more on a loaded machine).
+    global_estimate : GlobalTimeStep or None
+        None: the step rests on the bounds alone. Given
+        (:class:`colonsim.insertion.engine.global_time_step.GlobalTimeStep`): the largest frequency
+        of the coupled system by power iteration, never below that of a body whose own value is
+        exact (a rod), and the step never below the bounds' (:meth:`stable_time_step`).
     """
 
     def __init__(self, bodies, contacts=(), constraints=(), loads=(), damping=0.0, time_step=None,
                  time_step_factor=0.9, time_step_interval=100, time_step_growth=1.05, mass_scaling=None, initial_velocity=None,
-                 energy_growth_limit=10.0, parallel_min_nodes=50_000, resistances=()):
+                 energy_growth_limit=10.0, parallel_min_nodes=50_000, resistances=(), global_estimate=None):
         names = [b.name for b in bodies]
         if len(set(names)) != len(names):
             raise ColonsimError(f"body names must be unique, got {names}; rename the bodies.")
@@ -140,6 +145,7 @@ class ExplicitSolver:
             raise ColonsimError(f"time_step_growth = {time_step_growth} must be >= 1; fix it.")
         self.time_step_growth = float(time_step_growth)
         self.energy_growth_limit = float(energy_growth_limit)
+        self.global_estimate = global_estimate
         self.time = 0.0
         self.step = 0
         self.added_mass = {n: 0.0 for n in names}
@@ -167,14 +173,20 @@ class ExplicitSolver:
 
         Per body omega^2 = (2 / dt_body)^2 plus the contact penalty's contribution on that body
         (Gershgorin: the stiffness rows add; a contact reports its damped springs as equivalent
-        undamped ones). Contacts first adapt their penalty to the bodies' current frequencies.
+        undamped ones). Contacts first adapt their penalty to the bodies' current frequencies (from
+        the bounds, whichever estimate sets the step). With a ``global_estimate``, the step of the
+        coupled system's largest frequency instead, when it is the longer.
         """
         omega2 = {b.name: (2.0 / b.critical_time_step(self.state[b.name].x)) ** 2 for b in self.bodies}
+        exact = [omega2[b.name] for b in self.bodies if hasattr(b, "max_frequency")]  # a rod's is its eigenvalue
         for c in self.contacts:
             c.follow_wall(omega2)
             for name, w2 in c.frequency_squared().items():
                 omega2[name] += w2
-        return 2.0 / math.sqrt(max(omega2.values()))
+        bound = 2.0 / math.sqrt(max(omega2.values()))
+        if self.global_estimate is None:
+            return bound
+        return max(bound, 2.0 / math.sqrt(self.global_estimate.omega2(self, floor=max(exact, default=0.0))))
 
     def _update_time_step(self):
         if self.fixed_time_step is not None:
