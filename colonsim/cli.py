@@ -20,7 +20,7 @@ from colonsim.files import os_failure
 from colonsim.input_ranges import check_input_range
 from colonsim.limits import MESH_MAX, POINTS_RANGE
 from colonsim.options import bounded_int, finite_float, output_folder, positive_int, seed, worker_count
-from colonsim.insertion.case.insertion_case import InsertionCase
+from colonsim.insertion.case.insertion_case import TIME_STEP_ESTIMATES, InsertionCase
 from colonsim.insertion.case.run_budget import DEFAULT_MAX_STEPS
 
 
@@ -138,6 +138,10 @@ def _add_insert(sub):
     p.add_argument("--push-speed", type=finite_float, default=InsertionCase.push_speed,
                    help=f"plateau push speed, m/s (default {InsertionCase.push_speed:g}, quasi-static; the source "
                         "pushed at 0.6; half of it checks the rate: docs/model.md, \"Loading\")")
+    p.add_argument("--time-step-estimate", choices=TIME_STEP_ESTIMATES, default=InsertionCase.time_step_estimate,
+                   help="what the stable time step rests on: bounds (default) or global, the coupled system's "
+                        "largest frequency by power iteration (about 0.7 of the steps; docs/model.md, \"The global "
+                        "time-step estimate\")")
     p.add_argument("--material", help="material JSON from colonsim calibrate (default: the source's parameters)")
     p.add_argument("--flexure-angle", type=finite_float, default=90.0,
                    help="turn of the splenic (RSF) or hepatic (THF) flexure, degrees (default 90, an assumption)")
@@ -185,7 +189,7 @@ def cmd_insert(args):
                            wall_thickness_mm=args.wall_thickness,
                            element_size_mm=args.element_size, material=args.material,
                            exit_length_mm=args.exit_length, distal_resistance_N=args.distal_resistance,
-                           push_speed=args.push_speed,
+                           push_speed=args.push_speed, time_step_estimate=args.time_step_estimate,
                            **({} if args.scope_spacing is None else {"scope_spacing_mm": args.scope_spacing}))
              for scope in args.scope]
     if args.material is not None:

@@ -98,6 +98,7 @@ def ws(tmp_path_factory):
         "nan_value.toml": "[[grid]]\nfriction = nan\n",
         "not_toml.toml": "[grid\n",
         "typo.toml": '[grid]\nsegmnt = "rsj"\n',
+        "estimate.toml": '[[grid]]\ntime_step_estimate = "fast"\n',
         "stiff.toml": f'[fixed]\nmaterial = "{(ws / "stiff.json").as_posix()}"\n[[grid]]\nscope = ["utc", "sdc"]\n',
     }
     for name, text in toml.items():
@@ -141,6 +142,9 @@ CASES = [
     (["sweep", "{ws}/missing.toml", "--out", "{ws}/sweep_a"], "not found"),
     (["sweep", "{ws}/not_toml.toml", "--out", "{ws}/sweep_a"], "not valid TOML"),
     (["sweep", "{ws}/typo.toml", "--out", "{ws}/sweep_a"], "did you mean 'segment'?"),
+    (["sweep", "{ws}/estimate.toml", "--out", "{ws}/sweep_a"],
+     "time_step_estimate = 'fast' is not one of bounds, global; give \"bounds\" (the default) or \"global\""),
+    (["insert", "--time-step-estimate", "fast", "--out", "{ws}/ins"], "invalid choice: 'fast'"),
     (["sweep", "{ws}/fixed_only.toml", "--out", "{ws}/sweep_a"], "only [fixed] values"),
     (["sweep", "{ws}/empty_grid.toml", "--out", "{ws}/sweep_a"], "[grid] is empty"),
     (["sweep", "{ws}/inf_value.toml", "--out", "{ws}/sweep_a"], "angle_deg = inf; give a finite number"),
