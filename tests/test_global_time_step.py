@@ -102,3 +102,13 @@ def test_the_global_step_is_longer_than_the_bounds_and_stable():
     for _ in range(2000):
         coupled.advance()
     assert coupled.dt > 1.05 * bounds.time_step_factor * dt_bounds
+
+
+def test_the_estimate_enters_a_cases_key_only_when_global():
+    """At "bounds" the key is that of the runs made before the field existed (the thesis record's
+    RSJ 13.3 mm run), so every record stays valid; "global" is another run."""
+    from colonsim.insertion.case.insertion_case import InsertionCase
+
+    bounds = InsertionCase(segment="rsj", scope="13.3", time_step_estimate="bounds")
+    assert bounds.key() == "289196816b34"  # benchmarks/records/thesis
+    assert InsertionCase(segment="rsj", scope="13.3", time_step_estimate="global").key() != bounds.key()

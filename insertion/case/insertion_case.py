@@ -22,12 +22,13 @@ from colonsim.insertion.anatomy.scopes import colonoscope
 from colonsim.insertion.case.case_material import case_material
 
 # cases that do not use them stay what they were (existing sweep folders resume).
-LATER_FIELDS = ("centerline", "centerline_smoothing_mm", "material_parameters", "failure_stretch",
-                "time_step_estimate")
+LATER_FIELDS = ("centerline", "centerline_smoothing_mm", "material_parameters", "failure_stretch")
 # how the stable time step is estimated (docs/model.md, "The global time-step estimate")
 TIME_STEP_ESTIMATES = ("bounds", "global")
 # fields left out of the key at the value that gives the runs of before they existed
-ABSENT_AT = {"distal_resistance_N": 0.0, "held_push_share": 1.0, "held_push_lead_mm": 0.0, "relax_max_s": 0.0}
+# (a default changed to another value then gives new keys: no run of before is taken for one of it)
+ABSENT_AT = {"distal_resistance_N": 0.0, "held_push_share": 1.0, "held_push_lead_mm": 0.0, "relax_max_s": 0.0,
+             "time_step_estimate": "bounds"}
 
 
 @dataclass
