@@ -35,6 +35,8 @@ def plausible(key):
         return st.just("")
     if key == SCOPE_DIAMETER:
         return st.floats(8, 14)
+    if key == "time_step_estimate":
+        return st.sampled_from(["bounds", "global", "fast"])  # "fast": the one-line error
     default = DEFAULTS[key]
     return st.floats(0.5 * default, 1.5 * default) if default else st.floats(0, 0.2)
 
