@@ -9,7 +9,8 @@ insertion (the real run, its end rules and held push included) to a state in mid
 
 - prints the pieces of the estimate (s): the scope alone, the wall's membrane and hinge bounds,
   the wall alone from a Lanczos eigenvalue of its linearised stiffness (central differences of
-  its internal forces, held nodes out), and the step the run was using;
+  its internal forces, held nodes out), the step the run was using, and the stable step of the
+  global estimate (``time_step_estimate = "global"``, its power iteration run to convergence);
 - runs copies of that state at fixed steps of k times the estimate (k = 1.0, 1.1, ... until one
   diverges, ``--steps`` steps each) and prints the largest k that stayed stable and the first
   that diverged (the solver's divergence guard: mechanical energy above 10 times what was put
@@ -34,6 +35,7 @@ from colonsim.errors import ColonsimError
 from colonsim.insertion.case import scenario
 from colonsim.insertion.case.insertion_case import InsertionCase
 from colonsim.insertion.engine.contact import RodShellContact
+from colonsim.insertion.engine.global_time_step import GlobalTimeStep
 
 # each case and the simulated time (s) of its probed state: in the RSJ the tip rounds the sigmoid,
 # in RSF and THF the mobile colon is free and the scope pushes through the flexure
@@ -121,6 +123,8 @@ def probe(name, n_steps):
     membrane, hinges = model.shell.frequency_bounds(wall_x)
     true_wall = wall_lanczos(model.shell, wall_x, solver.state[model.shell.name].fixed == 0)
     contact = next(c for c in solver.contacts if isinstance(c, RodShellContact)).frequency_squared()
+    scope_w2 = (2.0 / model.rod.critical_time_step(solver.state[model.rod.name].x)) ** 2
+    global_w2 = GlobalTimeStep(first_iterations=500, tolerance=1e-8).omega2(solver, floor=scope_w2)
     stable, diverged = None, None
     for k in MULTIPLES:
         if stable_over(solver, k * estimate, n_steps):
@@ -135,6 +139,7 @@ def probe(name, n_steps):
         "wall_hinge_bound_s": 2.0 / math.sqrt(hinges), "wall_lanczos_s": 2.0 / math.sqrt(true_wall),
         "wall_with_contact_bound_s": 2.0 / math.sqrt(membrane + hinges + contact[model.shell.name]),
         "wall_lanczos_with_contact_s": 2.0 / math.sqrt(true_wall + contact[model.shell.name]),
+        "global_estimate_s": 2.0 / math.sqrt(global_w2),
         "largest_stable_multiple": stable, "first_diverged_multiple": diverged, "steps_per_trial": n_steps,
     }
     print(f"{name} at {solver.time:.3f} s (run and probed in {time.perf_counter() - t0:.0f} s): step in use "
@@ -143,6 +148,8 @@ def probe(name, n_steps):
           f"{row['wall_hinge_bound_s']:.3e}), wall alone by Lanczos {row['wall_lanczos_s']:.3e} s "
           f"(bound / Lanczos {row['wall_lanczos_s'] / row['wall_bound_s']:.2f} in the step); with the contact's wall "
           f"term {row['wall_with_contact_bound_s']:.3e} / {row['wall_lanczos_with_contact_s']:.3e} s", flush=True)
+    print(f"  the global estimate (power iteration, converged): {row['global_estimate_s']:.3e} s = "
+          f"{row['global_estimate_s'] / estimate:.2f} x the estimate", flush=True)
     limit = "none diverged" if diverged is None else f"first diverged at {diverged:.1f} x ({diverged * estimate:.3e} s)"
     print(f"  fixed steps over {n_steps} steps: stable up to {stable} x the estimate "
           f"({(stable or 0.0) * estimate:.3e} s), {limit}; the step in use is "
