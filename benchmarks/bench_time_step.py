@@ -35,7 +35,7 @@ from colonsim.errors import ColonsimError
 from colonsim.insertion.case import scenario
 from colonsim.insertion.case.insertion_case import InsertionCase
 from colonsim.insertion.engine.contact import RodShellContact
-from colonsim.insertion.engine.global_time_step import GlobalTimeStep
+from colonsim.insertion.engine.global_time_step import GlobalTimeStep, stiffness_action
 
 # each case and the simulated time (s) of its probed state: in the RSJ the tip rounds the sigmoid,
 # in RSF and THF the mobile colon is free and the scope pushes through the flexure
@@ -85,13 +85,7 @@ def wall_lanczos(shell, x, free):
     def matvec(flat):
         v = flat.reshape(x.shape).copy()
         v[~free] = 0.0
-        u = v / msq
-        eps = 1e-9 / max(float(np.abs(u).max()), 1e-300)
-        fp = np.zeros_like(x)
-        fm = np.zeros_like(x)
-        shell.internal_forces(x + eps * u, fp)
-        shell.internal_forces(x - eps * u, fm)
-        kv = -(fp - fm) / (2.0 * eps) / msq
+        kv = stiffness_action(shell, x, v / msq) / msq
         kv[~free] = 0.0
         return kv.ravel()
 

@@ -36,6 +36,12 @@ from colonsim.insertion.engine.contact_kernel import (contact_kernel, contact_ke
                                                       dissipation_rates, rod_reactions)
 
 
+def damped_step_reduction(zeta):
+    """Factor sqrt(1 + zeta^2) - zeta on the stable step of a spring damped at the fraction zeta of
+    critical (damping force from the previous half-step velocity)."""
+    return math.sqrt(1.0 + zeta * zeta) - zeta
+
+
 class RodShellContact:
     """Penalty contact with damping and regularised Coulomb friction between a rod and a shell.
 
@@ -257,10 +263,8 @@ class RodShellContact:
                               u[self.shell.name], u[self.rod.name], ku[self.shell.name], ku[self.rod.name])
 
     def damping_reduction(self):
-        """Factor sqrt(1 + zeta^2) - zeta on the stable step of a damped spring (damping force from
-        the previous half-step velocity)."""
-        z = self.damping_ratio
-        return math.sqrt(1.0 + z * z) - z
+        """:func:`damped_step_reduction` of this contact's springs."""
+        return damped_step_reduction(self.damping_ratio)
 
     def critical_time_step(self):
         """Stable step of the contact springs alone, s."""

@@ -34,6 +34,20 @@ def _dot(a, b):
     return float(np.multiply(a, b).sum())
 
 
+def stiffness_action(body, x, u):
+    """K u of ``body``'s internal forces linearised at ``x`` (central differences, a displacement of
+    1 nm at the largest component of ``u``), N."""
+    peak = float(np.abs(u).max())
+    if peak == 0.0:
+        return np.zeros_like(x)
+    eps = 1e-9 / peak
+    fp = np.zeros_like(x)
+    fm = np.zeros_like(x)
+    body.internal_forces(np.ascontiguousarray(x + eps * u), fp)
+    body.internal_forces(np.ascontiguousarray(x - eps * u), fm)
+    return -(fp - fm) / (2.0 * eps)
+
+
 FRESH_SHARE = 1e-3  # norm of the random vector added at each update (the iterate has norm 1)
 TINY = 1e-100  # iterate components below this are set to zero
 
@@ -61,8 +75,6 @@ class GlobalTimeStep:
         self._rng = np.random.default_rng(seed)
         self._v = None
         self._free_key = None
-        self.products = 0
-        self.last_omega2 = None
 
     def _masks(self, solver):
         """Per body: a (n, 1) array 1 where a node is integrated, 0 where it is held."""
@@ -75,22 +87,9 @@ class GlobalTimeStep:
     def _product(self, solver, v, masks, inv_sqrt_m):
         """A v for the per-body vectors ``v`` (zero on held nodes)."""
         u = {n: v[n] * inv_sqrt_m[n] for n in v}
-        ku = {}
-        for b in solver.bodies:
-            x = solver.state[b.name].x
-            peak = float(np.abs(u[b.name]).max())
-            if peak == 0.0:
-                ku[b.name] = np.zeros_like(x)
-                continue
-            eps = 1e-9 / peak  # a displacement of 1 nm at the largest component
-            fp = np.zeros_like(x)
-            fm = np.zeros_like(x)
-            b.internal_forces(np.ascontiguousarray(x + eps * u[b.name]), fp)
-            b.internal_forces(np.ascontiguousarray(x - eps * u[b.name]), fm)
-            ku[b.name] = -(fp - fm) / (2.0 * eps)
+        ku = {b.name: stiffness_action(b, solver.state[b.name].x, u[b.name]) for b in solver.bodies}
         for c in solver.contacts:
             c.spring_action(solver.state, u, ku)
-        self.products += 1
         return {n: ku[n] * inv_sqrt_m[n] * masks[n] for n in ku}
 
     def omega2(self, solver, floor=0.0):
@@ -128,5 +127,4 @@ class GlobalTimeStep:
                 break
             rq_prev = rq
         self._v = v
-        self.last_omega2 = max(rq, floor)
-        return self.last_omega2
+        return max(rq, floor)

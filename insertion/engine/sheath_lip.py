@@ -19,6 +19,7 @@ import numba
 import numpy as np
 
 from colonsim.errors import ColonsimError
+from colonsim.insertion.engine.contact import damped_step_reduction
 
 
 @numba.njit(cache=True)
@@ -138,8 +139,8 @@ class SheathLip:
         t = self._out[1]
         ur = u[self.rod.name]
         d = (1.0 - t) * ur[e] + t * ur[e + 1]
-        z = self.damping_ratio
-        force = self.stiffness / (math.sqrt(1.0 + z * z) - z) ** 2 * (d - (d @ self.direction) * self.direction)
+        k = self.stiffness / damped_step_reduction(self.damping_ratio) ** 2
+        force = k * (d - (d @ self.direction) * self.direction)
         out = ku[self.rod.name]
         out[e] += (1.0 - t) * force
         out[e + 1] += t * force
@@ -152,6 +153,5 @@ class SheathLip:
 
     def frequency_squared(self):
         """The spring's squared frequency on the lightest rod node, as a damped spring (rad^2/s^2)."""
-        z = self.damping_ratio
-        reduction = (math.sqrt(1.0 + z * z) - z) ** 2
+        reduction = damped_step_reduction(self.damping_ratio) ** 2
         return {self.rod.name: self.stiffness / float(self.rod.mass.min()) / reduction}
