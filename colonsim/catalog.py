@@ -367,6 +367,9 @@ COLUMNS = {c.name: c for c in (
     Column("time_step_factor", _S, "", "safety factor on the stable time step"),
     Column("time_step_estimate", _S, "", "what the stable time step rests on: bounds (default) or global (power "
                                          "iteration on the coupled system)"),
+    Column("contact_surface", _S, "", "where the contact samples the wall: nodes (default) or faces (points spread "
+                                      "over its triangles)"),
+    Column("contact_face_subdivision", _S, "", "with faces: L, the L^2 contact points per wall triangle"),
     Column("final_deformation_cm", _O, "cm", "colon deformation at the end of the run", DEFAULT_TARGET,
            "final colon deformation [cm]"),
     Column("max_deformation_cm", _O, "cm", "largest colon deformation during the run", DEFAULT_TARGET,

@@ -21,6 +21,7 @@ from colonsim.input_ranges import check_input_range
 from colonsim.limits import MESH_MAX, POINTS_RANGE
 from colonsim.options import bounded_int, finite_float, output_folder, positive_int, seed, worker_count
 from colonsim.insertion.case.insertion_case import TIME_STEP_ESTIMATES, InsertionCase
+from colonsim.insertion.engine.contact_points import WALL_SAMPLINGS
 from colonsim.insertion.case.run_budget import DEFAULT_MAX_STEPS
 
 
@@ -142,6 +143,10 @@ def _add_insert(sub):
                    help="what the stable time step rests on: bounds (default) or global, the coupled system's "
                         "largest frequency by power iteration (about 0.7 of the steps; docs/model.md, \"The global "
                         "time-step estimate\")")
+    p.add_argument("--contact-surface", choices=WALL_SAMPLINGS, default=InsertionCase.contact_surface,
+                   help="where the contact samples the wall: its nodes (default) or points spread over its triangles, "
+                        f"{InsertionCase.contact_face_subdivision ** 2} per triangle (the scope no longer rises and "
+                        "sinks over the wall's nodes; docs/model.md, \"Contact\")")
     p.add_argument("--material", help="material JSON from colonsim calibrate (default: the source's parameters)")
     p.add_argument("--flexure-angle", type=finite_float, default=90.0,
                    help="turn of the splenic (RSF) or hepatic (THF) flexure, degrees (default 90, an assumption)")
@@ -190,6 +195,7 @@ def cmd_insert(args):
                            element_size_mm=args.element_size, material=args.material,
                            exit_length_mm=args.exit_length, distal_resistance_N=args.distal_resistance,
                            push_speed=args.push_speed, time_step_estimate=args.time_step_estimate,
+                           contact_surface=args.contact_surface,
                            **({} if args.scope_spacing is None else {"scope_spacing_mm": args.scope_spacing}))
              for scope in args.scope]
     if args.material is not None:

@@ -99,6 +99,8 @@ def ws(tmp_path_factory):
         "not_toml.toml": "[grid\n",
         "typo.toml": '[grid]\nsegmnt = "rsj"\n',
         "estimate.toml": '[[grid]]\ntime_step_estimate = "fast"\n',
+        "surface.toml": '[[grid]]\ncontact_surface = "edges"\n',
+        "subdivision.toml": '[[grid]]\ncontact_surface = "faces"\ncontact_face_subdivision = 0\n',
         "stiff.toml": f'[fixed]\nmaterial = "{(ws / "stiff.json").as_posix()}"\n[[grid]]\nscope = ["utc", "sdc"]\n',
     }
     for name, text in toml.items():
@@ -145,6 +147,11 @@ CASES = [
     (["sweep", "{ws}/estimate.toml", "--out", "{ws}/sweep_a"],
      "time_step_estimate = 'fast' is not one of bounds, global; give \"bounds\" (the default) or \"global\""),
     (["insert", "--time-step-estimate", "fast", "--out", "{ws}/ins"], "invalid choice: 'fast'"),
+    (["sweep", "{ws}/surface.toml", "--out", "{ws}/sweep_a"],
+     "contact_surface = 'edges' is not one of nodes, faces; give \"nodes\" or \"faces\""),
+    (["sweep", "{ws}/subdivision.toml", "--out", "{ws}/sweep_a"],
+     "contact_face_subdivision = 0 is not a whole number from 1 to 8"),
+    (["insert", "--contact-surface", "edges", "--out", "{ws}/ins"], "invalid choice: 'edges'"),
     (["sweep", "{ws}/fixed_only.toml", "--out", "{ws}/sweep_a"], "only [fixed] values"),
     (["sweep", "{ws}/empty_grid.toml", "--out", "{ws}/sweep_a"], "[grid] is empty"),
     (["sweep", "{ws}/inf_value.toml", "--out", "{ws}/sweep_a"], "angle_deg = inf; give a finite number"),

@@ -40,7 +40,7 @@ def test_broad_phase_finds_every_contact_of_all_pairs():
     dist = np.linalg.norm(w - t[..., None] * e[None], axis=2)
     in_contact = dist.min(axis=1) < rod.radius + 0.5 * T
     near = np.flatnonzero(dist.min(axis=1) < contact.cutoff)
-    assert np.array_equal(np.sort(contact._nodes), near)
+    assert np.array_equal(np.sort(contact._points), near)
     assert contact.n_candidates == int((dist < contact.cutoff).sum())
     got = np.linalg.norm(state["wall"].f_con, axis=1) > 0.0
     assert np.array_equal(got, in_contact)

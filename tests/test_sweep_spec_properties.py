@@ -37,6 +37,10 @@ def plausible(key):
         return st.floats(8, 14)
     if key == "time_step_estimate":
         return st.sampled_from(["bounds", "global", "fast"])  # "fast": the one-line error
+    if key == "contact_surface":
+        return st.sampled_from(["nodes", "faces", "edges"])  # "edges": the one-line error
+    if key == "contact_face_subdivision":
+        return st.integers(0, 9)  # 0 and 9: the one-line error
     default = DEFAULTS[key]
     return st.floats(0.5 * default, 1.5 * default) if default else st.floats(0, 0.2)
 

@@ -20,6 +20,7 @@ from colonsim.insertion.anatomy.colon_segments import check_patient_tube
 from colonsim.insertion.anatomy.patient_centerline import SMOOTHING_MM, load_patient_centerline
 from colonsim.insertion.anatomy.scopes import colonoscope
 from colonsim.insertion.case.case_material import case_material
+from colonsim.insertion.engine.contact_points import WALL_SAMPLINGS
 
 # cases that do not use them stay what they were (existing sweep folders resume).
 LATER_FIELDS = ("centerline", "centerline_smoothing_mm", "material_parameters", "failure_stretch")
@@ -28,7 +29,7 @@ TIME_STEP_ESTIMATES = ("bounds", "global")
 # fields left out of the key at the value that gives the runs of before they existed
 # (a default changed to another value then gives new keys: no run of before is taken for one of it)
 ABSENT_AT = {"distal_resistance_N": 0.0, "held_push_share": 1.0, "held_push_lead_mm": 0.0, "relax_max_s": 0.0,
-             "time_step_estimate": "bounds"}
+             "time_step_estimate": "bounds", "contact_surface": "nodes"}
 
 
 @dataclass
@@ -118,6 +119,11 @@ class InsertionCase:
         Simulated time between recorded samples.
     time_step_factor : float
         Safety factor on the stable time step.
+    contact_surface : str
+        Where the contact samples the wall: "nodes" (its nodes) or "faces" (points spread over its
+        triangles, ``contact_face_subdivision`` squared per triangle; docs/model.md, "Contact").
+    contact_face_subdivision : int
+        With "faces": L, the L^2 points per triangle (spaced about a 1 / L of the element size).
     time_step_estimate : str
         "bounds" (element and Gershgorin bounds, the default) or "global" (the coupled system's
         largest frequency by power iteration, never a shorter step than the bounds'; docs/model.md,
@@ -161,6 +167,8 @@ class InsertionCase:
     time_step_factor: float = 0.9
     material_parameters: dict | None = None
     time_step_estimate: str = "bounds"
+    contact_surface: str = "nodes"
+    contact_face_subdivision: int = 2
 
     def validate(self):
         """Raise :class:`ColonsimError` naming the first bad input and its fix."""
@@ -207,6 +215,12 @@ class InsertionCase:
         if self.time_step_estimate not in TIME_STEP_ESTIMATES:
             raise ColonsimError(f"time_step_estimate = {self.time_step_estimate!r} is not one of "
                                 f"{', '.join(TIME_STEP_ESTIMATES)}; give \"bounds\" (the default) or \"global\"")
+        if self.contact_surface not in WALL_SAMPLINGS:
+            raise ColonsimError(f"contact_surface = {self.contact_surface!r} is not one of "
+                                f"{', '.join(WALL_SAMPLINGS)}; give \"nodes\" or \"faces\"")
+        if not (isinstance(self.contact_face_subdivision, int) and 1 <= self.contact_face_subdivision <= 8):
+            raise ColonsimError(f"contact_face_subdivision = {self.contact_face_subdivision!r} is not a whole number "
+                                "from 1 to 8; give the points per triangle edge (2)")
         if 0.0 < self.relax_max_s < self.relax_s:
             raise ColonsimError(f"relax_max_s = {self.relax_max_s:g} s is shorter than relax_s = {self.relax_s:g} s; "
                                 "give at least relax_s, or 0 for a relax of relax_s")
@@ -259,6 +273,8 @@ class InsertionCase:
         model = COLON_MODELS.get(self.segment)
         if model is not None and not model.straightens:  # no relax: its bound does nothing
             inputs.pop("relax_max_s", None)
+        if "contact_surface" not in inputs:  # the wall's nodes: no face points to subdivide
+            inputs.pop("contact_face_subdivision", None)
         if "distal_resistance_N" not in inputs:  # nothing holds the tip: the held push never starts
             inputs.pop("held_push_share", None)
             inputs.pop("held_push_lead_mm", None)

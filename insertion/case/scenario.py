@@ -157,7 +157,8 @@ def build_insertion(case: InsertionCase) -> Insertion:
 
     # tube meshes are oriented with normals out of the lumen: the fixed wall's rest normals
     contact = RodShellContact(rod, shell, friction=case.friction,
-                              held_normals=shell.node_normals(np.ascontiguousarray(shell.x0)))
+                              held_normals=shell.node_normals(np.ascontiguousarray(shell.x0)),
+                              surface=case.contact_surface, face_subdivision=case.contact_face_subdivision)
     held = np.flatnonzero(geometry.fixed | geometry.end_ring)
     constraints = [FixedNodes(shell, held)]
     mobile = np.flatnonzero(geometry.mobile & ~geometry.end_ring)

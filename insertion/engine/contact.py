@@ -1,25 +1,29 @@
-"""Frictional penalty contact between a rod (the scope) and the nodes of a shell (the colon wall).
+"""Frictional penalty contact between a rod (the scope) and a shell (the colon wall).
 
 The scope surface is the union of capsules of radius ``rod.radius`` around its segments; the
-end caps are spheres, so the distal one is the hemispherical tip. The wall is its node set,
-offset by half the wall thickness (the mid-surface carries the nodes, the lumen is ``offset``
-inside it). Each wall node in contact takes the closest point of the scope surface (the minimum
-over capsules, so a node near a joint between two segments is counted once):
+end caps are spheres, so the distal one is the hemispherical tip. The wall is a set of contact
+points, its nodes or points spread over its triangles (``surface``,
+:mod:`colonsim.insertion.engine.contact_points`), offset by half the wall thickness (the
+mid-surface carries the nodes, the lumen is ``offset`` inside it). Each point in contact takes
+the closest point of the scope surface (the minimum over capsules, so a point near a joint
+between two segments is counted once):
 
     gap g = |p - c| - radius - offset,   n = (p - c) / |p - c|
     normal force  f_n = max(k (-g) - c_n v_n, 0),   c_n = 2 zeta sqrt(k m_eff)
     friction      f_t = -mu f_n v_t / max(|v_t|, v_reg)
 
 with c the closest point on the segment axis, v_n, v_t the normal and tangential relative
-velocity, m_eff the reduced mass of the wall node (infinite when fixed) and the rod point, and k
+velocity, m_eff the reduced mass of the wall point (infinite when held) and the rod point, and k
 the penalty of a free wall node, or the stiffer one of a held node (whose spring loads only the
-rod, so the wall's light nodes do not limit it). Given ``held_normals``, a held node's n is the
-fixed wall's rest normal instead: the fixed colon acts as a rigid smooth tube (docs/model.md,
-"Contact"), which pushes the scope across its axis but never back along it.
+rod, so the wall's light nodes do not limit it), each times the point's share of a node (1 for
+nodes). Given ``held_normals``, a held point's n is the fixed wall's rest normal instead: the
+fixed colon acts as a rigid smooth tube (docs/model.md, "Contact"), which pushes the scope across
+its axis but never back along it.
 Friction is Coulomb, regularised by a slip velocity v_reg: below mu f_n the contact "sticks"
 by creeping at |v_t| = v_reg |F_t| / (mu f_n); v_reg is raised where needed to mu f_n dt / m_eff
 so that the viscous friction stays stable in explicit time stepping. The reaction on the rod is
-split linearly between the segment's two nodes.
+split linearly between the segment's two nodes, the force on the wall onto the point's nodes by
+their weights.
 
 The broad phase (candidate pairs) is :mod:`.contact_broad_phase`, the narrow phase (forces per
 candidate) :mod:`.contact_kernel`; this module holds the contact object the solver calls.
@@ -33,7 +37,8 @@ from colonsim.errors import ColonsimError
 from colonsim.insertion.engine.contact_broad_phase import (candidate_counts, candidate_fill, max_displacement,
                                                            segment_cell_table)
 from colonsim.insertion.engine.contact_kernel import (contact_kernel, contact_kernel_serial, contact_spring_action,
-                                                      dissipation_rates, rod_reactions)
+                                                      dissipation_rates, rod_reactions, wall_reactions)
+from colonsim.insertion.engine.contact_points import WALL_SAMPLINGS, face_points, node_points
 
 
 def damped_step_reduction(zeta):
@@ -77,10 +82,15 @@ class RodShellContact:
         normal (docs/model.md, "Contact"): a held ring next to a bulged mobile wall is then a
         boundary the tip slides along, not a ledge it catches on. None: held nodes push along the
         line from the rod's axis to the node, like free ones.
+    surface : str
+        Where the contact samples the wall: ``"nodes"`` (its nodes) or ``"faces"`` (points spread
+        over its triangles, :func:`colonsim.insertion.engine.contact_points.face_points`).
+    face_subdivision : int
+        With ``surface="faces"``: L, the points per triangle being L^2 (spaced about h / L).
     """
 
     def __init__(self, rod, shell, stiffness=None, damping_ratio=0.5, friction=0.0, slip_velocity=1e-3,
-                 offset=None, skin=None, held_stiffness=None, held_normals=None):
+                 offset=None, skin=None, held_stiffness=None, held_normals=None, surface="nodes", face_subdivision=2):
         self.rod = rod
         self.shell = shell
         self.offset = 0.5 * shell.thickness if offset is None else float(offset)
@@ -106,21 +116,27 @@ class RodShellContact:
         self.slip_velocity = float(slip_velocity)
         self.cutoff = rod.radius + self.offset + self.skin
         self.cell = max(2.0 * self.cutoff, float(rod.rest_length.max()))
-        if held_normals is None:  # zeros: the kernel's flag to push along the axis-to-node line
-            self._held_normal = np.zeros_like(shell.x0)
+        if held_normals is None:  # zeros: the kernel's flag to push along the axis-to-point line
+            held_normal = np.zeros_like(shell.x0)
         else:
-            self._held_normal = np.ascontiguousarray(held_normals, dtype=np.float64)
-            if self._held_normal.shape != shell.x0.shape or not np.all(np.isfinite(self._held_normal)):
+            held_normal = np.ascontiguousarray(held_normals, dtype=np.float64)
+            if held_normal.shape != shell.x0.shape or not np.all(np.isfinite(held_normal)):
                 raise ColonsimError(f"held_normals must be finite unit vectors of shape {shell.x0.shape}; fix them.")
+        if surface not in WALL_SAMPLINGS:
+            raise ColonsimError(f"contact surface = {surface!r} is not one of {', '.join(WALL_SAMPLINGS)}; fix it.")
+        if surface == "nodes":
+            self.points = node_points(len(shell.x0), held_normal)
+        else:
+            self.points = face_points(shell.x0, shell.triangles, face_subdivision, held_normal)
         self._xr_build = None
         self._xs_build = None
         self.n_rebuilds = 0
         # below this many candidate wall nodes the narrow phase runs serially (cheaper than threads)
         self.parallel_min_candidates = 20_000
-        self._nodes = np.zeros(0, dtype=np.int64)
+        self._points = np.zeros(0, dtype=np.int64)
         self._ptr = np.zeros(1, dtype=np.int64)
         self._cand = np.zeros(0, dtype=np.int64)
-        self._counts = np.zeros(len(shell.x0), dtype=np.int64)
+        self._counts = np.zeros(len(self.points), dtype=np.int64)
         self._load = np.zeros(len(rod.x0))
         self._rod_weight = 0.0
         self.energy = 0.0
@@ -155,7 +171,7 @@ class RodShellContact:
 
     @property
     def n_candidates(self):
-        """Candidate (wall node, segment) pairs of the current list."""
+        """Candidate (contact point, segment) pairs of the current list."""
         return len(self._cand)
 
     def _needs_rebuild(self, xr, xs):
@@ -165,22 +181,24 @@ class RodShellContact:
         return moved > self.skin
 
     def build_candidates(self, xr, xs):
-        """Rebuild the candidate pairs for rod positions xr and wall positions xs."""
+        """Rebuild the candidate pairs for rod positions xr and wall positions xs (the points move no
+        farther than their nodes, so the nodes' displacement decides when to rebuild)."""
         seg = self.rod.segments
         keys, ids = segment_cell_table(xr, seg, self.cutoff, self.cell)
-        candidate_counts(xs, xr, seg, keys, ids, self.cutoff, self.cell, self._counts)
-        nodes = np.flatnonzero(self._counts).astype(np.int64)
-        ptr = np.zeros(len(nodes) + 1, dtype=np.int64)
-        np.cumsum(self._counts[nodes], out=ptr[1:])
+        xp = self.points.positions(xs)
+        candidate_counts(xp, xr, seg, keys, ids, self.cutoff, self.cell, self._counts)
+        points = np.flatnonzero(self._counts).astype(np.int64)
+        ptr = np.zeros(len(points) + 1, dtype=np.int64)
+        np.cumsum(self._counts[points], out=ptr[1:])
         cand = np.empty(ptr[-1], dtype=np.int64)
-        candidate_fill(xs, xr, seg, keys, ids, self.cutoff, self.cell, nodes, ptr, cand)
-        self._nodes, self._ptr, self._cand = nodes, ptr, cand
-        self._rod_seg = np.full(len(nodes), -1, dtype=np.int64)
-        self._rod_t = np.zeros(len(nodes))
-        self._rod_k = np.zeros(len(nodes))
-        self._rod_f = np.zeros((len(nodes), 3))
-        self._damp_f = np.zeros((len(nodes), 3))
-        self._fric_f = np.zeros((len(nodes), 3))
+        candidate_fill(xp, xr, seg, keys, ids, self.cutoff, self.cell, points, ptr, cand)
+        self._points, self._ptr, self._cand = points, ptr, cand
+        self._rod_seg = np.full(len(points), -1, dtype=np.int64)
+        self._rod_t = np.zeros(len(points))
+        self._rod_k = np.zeros(len(points))
+        self._rod_f = np.zeros((len(points), 3))
+        self._damp_f = np.zeros((len(points), 3))
+        self._fric_f = np.zeros((len(points), 3))
         self._xr_build = xr.copy()
         self._xs_build = xs.copy()
         self.n_rebuilds += 1
@@ -193,14 +211,15 @@ class RodShellContact:
         s = state[self.shell.name]
         if self._needs_rebuild(r.x, s.x):
             self.build_candidates(r.x, s.x)
-        kernel = contact_kernel if len(self._nodes) >= self.parallel_min_candidates else contact_kernel_serial
+        kernel = contact_kernel if len(self._points) >= self.parallel_min_candidates else contact_kernel_serial
+        pts = self.points
         energy, p_damp, p_fric, n_active, normal = kernel(
-            s.x, s.v, self.shell.mass, s.fixed, self._held_normal, r.x, r.v, self.rod.mass, self.rod.segments,
-            self._nodes, self._ptr,
-            self._cand, self.rod.radius, self.offset, self.stiffness, self.held_stiffness, self.damping_ratio,
-            self.friction, self.slip_velocity, dt, s.f_con, self._rod_seg, self._rod_t, self._rod_k, self._rod_f,
-            self._damp_f, self._fric_f,
+            s.x, s.v, self.shell.mass, s.fixed, pts.nodes, pts.weights, pts.share, pts.held_normal, r.x, r.v,
+            self.rod.mass, self.rod.segments, self._points, self._ptr, self._cand, self.rod.radius, self.offset,
+            self.stiffness, self.held_stiffness, self.damping_ratio, self.friction, self.slip_velocity, dt,
+            self._rod_seg, self._rod_t, self._rod_k, self._rod_f, self._damp_f, self._fric_f,
         )
+        wall_reactions(self._points, pts.nodes, pts.weights, self._rod_seg, self._rod_f, s.f_con)
         f0, f1, f2, weight = rod_reactions(self.rod.segments, self._rod_seg, self._rod_t, self._rod_k, self._rod_f,
                                            self.rod.mass, r.f_con, self._load)
         self.energy = energy
@@ -215,10 +234,11 @@ class RodShellContact:
         """Accumulate the energy dissipated during the step: the forces of the step times the
         relative velocity averaged over the old and new half-step velocities (as the solver
         sums the work on the bodies)."""
-        if len(self._nodes) == 0:
+        if len(self._points) == 0:
             return
         p_damp, p_fric = dissipation_rates(state[self.shell.name].v, state[self.rod.name].v, self.rod.segments,
-                                           self._nodes, self._rod_seg, self._rod_t, self._damp_f, self._fric_f)
+                                           self._points, self.points.nodes, self.points.weights, self._rod_seg,
+                                           self._rod_t, self._damp_f, self._fric_f)
         self.dissipated += 0.5 * (self._p_damp + p_damp + self._p_fric + p_fric) * dt
         self.friction_dissipated += 0.5 * (self._p_fric + p_fric) * dt
 
@@ -239,7 +259,8 @@ class RodShellContact:
     def frequency_squared(self):
         """Squared frequency the penalty springs add to each body (Gershgorin rows), rad^2/s^2.
 
-        Wall: one free spring per node, k / m. Rod: the largest penalty stiffness per unit mass
+        Wall: one free spring per node, k / m (with points on the faces: the largest of the
+        penalty the points put on a node, over its mass). Rod: the largest penalty stiffness per unit mass
         on a rod node of the last evaluation, doubled for contacts appearing before the next
         update, and at least that of four full held-node contacts on the lightest rod node. Both
         are divided by the square of :meth:`damping_reduction` (a damped spring counts as a
@@ -247,7 +268,8 @@ class RodShellContact:
         """
         reduction = self.damping_reduction() ** 2
         rod_w2 = max(2.0 * self._rod_weight, 4.0 * self.held_stiffness / float(self.rod.mass.min()))
-        return {self.shell.name: self.stiffness / float(self.shell.mass.min()) / reduction,
+        wall_mass = float((self.shell.mass / self.points.node_share).min())  # the lightest node's, for nodes
+        return {self.shell.name: self.stiffness / wall_mass / reduction,
                 self.rod.name: rod_w2 / reduction}
 
     def spring_action(self, state, u, ku):
@@ -255,12 +277,14 @@ class RodShellContact:
         name, (n, 3) arrays; ``u`` the displacements), each counted as k / r^2 for its damping
         (:meth:`damping_reduction`), as the bounds count it
         (:class:`colonsim.insertion.engine.global_time_step.GlobalTimeStep`)."""
-        if len(self._nodes) == 0:
+        if len(self._points) == 0:
             return
         s = state[self.shell.name]
-        contact_spring_action(s.x, state[self.rod.name].x, self.rod.segments, self._nodes, self._rod_seg, self._rod_t,
-                              self._rod_k, s.fixed, self._held_normal, 1.0 / self.damping_reduction() ** 2,
-                              u[self.shell.name], u[self.rod.name], ku[self.shell.name], ku[self.rod.name])
+        pts = self.points
+        contact_spring_action(s.x, state[self.rod.name].x, self.rod.segments, self._points, pts.nodes, pts.weights,
+                              self._rod_seg, self._rod_t, self._rod_k, s.fixed, pts.held_normal,
+                              1.0 / self.damping_reduction() ** 2, u[self.shell.name], u[self.rod.name],
+                              ku[self.shell.name], ku[self.rod.name])
 
     def damping_reduction(self):
         """:func:`damped_step_reduction` of this contact's springs."""

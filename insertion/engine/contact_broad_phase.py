@@ -1,9 +1,11 @@
-"""Broad phase of the rod-shell contact: candidate (wall node, rod segment) pairs.
+"""Broad phase of the rod-shell contact: candidate (contact point, rod segment) pairs.
 
-Broad phase: candidate (wall node, segment) pairs within radius + offset + skin, found with
-a uniform cell hash of the inflated segment boxes (sorted cell keys, one binary search per wall
-node); rebuilt only when the nodes have moved more than the skin since the last build, so the
-per-step cost scales with the number of candidates, not with all pairs. The narrow phase runs
+Broad phase: candidate (contact point of the wall, segment) pairs within radius + offset + skin,
+found with a uniform cell hash of the inflated segment boxes (sorted cell keys, one binary search
+per point; the points are the wall's nodes or points on its faces,
+:mod:`colonsim.insertion.engine.contact_points`); rebuilt only when the nodes have moved more
+than the skin since the last build, so the per-step cost scales with the number of candidates,
+not with all pairs. The narrow phase runs
 on threads for large candidate lists (``parallel_min_candidates``), serially otherwise.
 """
 
@@ -45,10 +47,10 @@ def segment_cell_table(xr, seg, cutoff, cell):
 
 @numba.njit(cache=True)
 def candidate_counts(xs, xr, seg, keys, ids, cutoff, cell, counts):
-    """Number of segments within ``cutoff`` of each wall node, into ``counts``.
+    """Number of segments within ``cutoff`` of each point of ``xs``, into ``counts``.
 
     Serial: it runs only when the list is rebuilt (every few hundred steps) and costs a hash
-    lookup per wall node."""
+    lookup per point."""
     n = xs.shape[0]
     c2 = cutoff * cutoff
     for i in range(n):
@@ -67,7 +69,7 @@ def candidate_counts(xs, xr, seg, keys, ids, cutoff, cell, counts):
 
 @numba.njit(cache=True)
 def candidate_fill(xs, xr, seg, keys, ids, cutoff, cell, nodes, ptr, out):
-    """Segment ids near each listed wall node into ``out[ptr[c]:ptr[c + 1]]`` (serial, see
+    """Segment ids near each listed point into ``out[ptr[c]:ptr[c + 1]]`` (serial, see
     :func:`candidate_counts`)."""
     c2 = cutoff * cutoff
     for c in range(nodes.shape[0]):

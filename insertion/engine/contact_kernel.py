@@ -1,7 +1,13 @@
-"""Narrow phase of the rod-shell contact: penalty, damping and friction forces per candidate pair
-(the law is in :mod:`colonsim.insertion.engine.contact`'s docstring), the power they dissipate,
-and the reactions split onto the rod nodes; the active springs' stiffness times a displacement,
-for the global time-step estimate (:mod:`colonsim.insertion.engine.global_time_step`).
+"""Narrow phase of the rod-shell contact: penalty, damping and friction forces per candidate
+contact point of the wall (the law is in :mod:`colonsim.insertion.engine.contact`'s docstring;
+the points, wall nodes or points on its faces, in :mod:`colonsim.insertion.engine.contact_points`),
+the power they dissipate, and the reactions split onto the rod nodes and the wall nodes; the
+active springs' stiffness times a displacement, for the global time-step estimate
+(:mod:`colonsim.insertion.engine.global_time_step`).
+
+A point rests on ``pn[q, :]`` wall nodes with weights ``pw[q, :]`` and takes ``ps[q]`` of a node's
+penalty and mass. Gathering starts from the first node's term, so a point that is a node (one
+node, weight 1, share 1) gives the node's own numbers to the bit.
 
 The force kernel is one source compiled threaded and serial (:mod:`._compile`).
 """
@@ -15,14 +21,14 @@ from colonsim.insertion.engine._compile import threaded_and_serial
 
 
 @numba.njit(cache=True, inline="always")
-def point_segment(xs, i, xr, a, b):
-    """Squared distance from wall node i to segment (a, b) and the segment parameter t in [0, 1]."""
+def point_segment_at(p0, p1, p2, xr, a, b):
+    """Squared distance from the point (p0, p1, p2) to segment (a, b) and the segment parameter t in [0, 1]."""
     e0 = xr[b, 0] - xr[a, 0]
     e1 = xr[b, 1] - xr[a, 1]
     e2 = xr[b, 2] - xr[a, 2]
-    w0 = xs[i, 0] - xr[a, 0]
-    w1 = xs[i, 1] - xr[a, 1]
-    w2 = xs[i, 2] - xr[a, 2]
+    w0 = p0 - xr[a, 0]
+    w1 = p1 - xr[a, 1]
+    w2 = p2 - xr[a, 2]
     ee = e0 * e0 + e1 * e1 + e2 * e2
     t = (w0 * e0 + w1 * e1 + w2 * e2) / ee if ee > 0.0 else 0.0
     t = min(max(t, 0.0), 1.0)
@@ -32,20 +38,47 @@ def point_segment(xs, i, xr, a, b):
     return d0 * d0 + d1 * d1 + d2 * d2, t
 
 
-@numba.njit(cache=True, inline="always")  # a call per node would cost more than its work
-def _contact_one(c, xs, vs, ms, fixed_s, held_n, xr, vr, mr, seg, nodes, ptr, cand, radius, offset, k_free, k_held,
-                 zeta, mu, v_slip, dt, fs, rod_seg, rod_t, rod_k, rod_f, damp_f, fric_f):
-    """Contact of candidate wall node ``nodes[c]``: (energy, damping power, friction power,
-    active 0/1, normal force)."""
+@numba.njit(cache=True, inline="always")
+def point_segment(xs, i, xr, a, b):
+    """Squared distance from point i of ``xs`` to segment (a, b) and the segment parameter t in [0, 1]."""
+    return point_segment_at(xs[i, 0], xs[i, 1], xs[i, 2], xr, a, b)
+
+
+@numba.njit(cache=True, inline="always")
+def gather(values, pn, pw, q, k):
+    """Component k of point q's interpolation of the nodal ``values`` (n, 3)."""
+    s = pw[q, 0] * values[pn[q, 0], k]
+    for j in range(1, pn.shape[1]):
+        s += pw[q, j] * values[pn[q, j], k]
+    return s
+
+
+@numba.njit(cache=True, inline="always")
+def point_held(fixed_s, pn, q):
+    """Is point q held (every node it rests on held at rest)?"""
+    for j in range(pn.shape[1]):
+        if fixed_s[pn[q, j]] == 0:
+            return False
+    return True
+
+
+@numba.njit(cache=True, inline="always")  # a call per point would cost more than its work
+def _contact_one(c, xs, vs, ms, fixed_s, pn, pw, ps, held_n, xr, vr, mr, seg, points, ptr, cand, radius, offset,
+                 k_free, k_held, zeta, mu, v_slip, dt, rod_seg, rod_t, rod_k, rod_f, damp_f, fric_f):
+    """Contact of candidate point ``points[c]``: (energy, damping power, friction power, active
+    0/1, normal force). The force on the wall is ``-rod_f[c]`` (:func:`wall_reactions`)."""
     reach = radius + offset
     rod_seg[c] = -1
-    i = nodes[c]
+    q = points[c]
+    p0 = gather(xs, pn, pw, q, 0)
+    p1 = gather(xs, pn, pw, q, 1)
+    p2 = gather(xs, pn, pw, q, 2)
     best = np.inf
     best_s = -1
     best_t = 0.0
     for p in range(ptr[c], ptr[c + 1]):
         s = cand[p]
-        d2, t = point_segment(xs, i, xr, seg[s, 0], seg[s, 1])
+        d2, t = point_segment_at(p0, p1, p2, xr, seg[s, 0], seg[s, 1])
         if d2 < best:
             best = d2
             best_s = s
@@ -57,21 +90,26 @@ def _contact_one(c, xs, vs, ms, fixed_s, held_n, xr, vr, mr, seg, nodes, ptr, ca
     a = seg[best_s, 0]
     b = seg[best_s, 1]
     t = best_t
-    if fixed_s[i] and (held_n[i, 0] != 0.0 or held_n[i, 1] != 0.0 or held_n[i, 2] != 0.0):
+    held = point_held(fixed_s, pn, q)
+    if held and (held_n[q, 0] != 0.0 or held_n[q, 1] != 0.0 or held_n[q, 2] != 0.0):
         # a point of the rigid fixed wall: it pushes along that wall's normal at rest
-        n0 = held_n[i, 0]
-        n1 = held_n[i, 1]
-        n2 = held_n[i, 2]
+        n0 = held_n[q, 0]
+        n1 = held_n[q, 1]
+        n2 = held_n[q, 2]
     else:
-        n0 = (xs[i, 0] - ((1.0 - t) * xr[a, 0] + t * xr[b, 0])) / dist
-        n1 = (xs[i, 1] - ((1.0 - t) * xr[a, 1] + t * xr[b, 1])) / dist
-        n2 = (xs[i, 2] - ((1.0 - t) * xr[a, 2] + t * xr[b, 2])) / dist
+        n0 = (p0 - ((1.0 - t) * xr[a, 0] + t * xr[b, 0])) / dist
+        n1 = (p1 - ((1.0 - t) * xr[a, 1] + t * xr[b, 1])) / dist
+        n2 = (p2 - ((1.0 - t) * xr[a, 2] + t * xr[b, 2])) / dist
+    m = pw[q, 0] * ms[pn[q, 0]]
+    for j in range(1, pn.shape[1]):
+        m += pw[q, j] * ms[pn[q, j]]
+    m *= ps[q]
     mrc = (1.0 - t) * mr[a] + t * mr[b]
-    meff = mrc if fixed_s[i] else ms[i] * mrc / (ms[i] + mrc)
-    k = k_held if fixed_s[i] else k_free
-    u0 = vs[i, 0] - ((1.0 - t) * vr[a, 0] + t * vr[b, 0])
-    u1 = vs[i, 1] - ((1.0 - t) * vr[a, 1] + t * vr[b, 1])
-    u2 = vs[i, 2] - ((1.0 - t) * vr[a, 2] + t * vr[b, 2])
+    meff = mrc if held else m * mrc / (m + mrc)
+    k = (k_held if held else k_free) * ps[q]
+    u0 = gather(vs, pn, pw, q, 0) - ((1.0 - t) * vr[a, 0] + t * vr[b, 0])
+    u1 = gather(vs, pn, pw, q, 1) - ((1.0 - t) * vr[a, 1] + t * vr[b, 1])
+    u2 = gather(vs, pn, pw, q, 2) - ((1.0 - t) * vr[a, 2] + t * vr[b, 2])
     vn = u0 * n0 + u1 * n1 + u2 * n2
     elastic = k * pen
     fn = elastic - 2.0 * zeta * math.sqrt(k * meff) * vn
@@ -95,27 +133,22 @@ def _contact_one(c, xs, vs, ms, fixed_s, held_n, xr, vr, mr, seg, nodes, ptr, ca
     fric_f[c, 0] = -ft * t0
     fric_f[c, 1] = -ft * t1
     fric_f[c, 2] = -ft * t2
-    f0 = fn * n0 - ft * t0
-    f1 = fn * n1 - ft * t1
-    f2 = fn * n2 - ft * t2
-    fs[i, 0] += f0
-    fs[i, 1] += f1
-    fs[i, 2] += f2
     rod_seg[c] = best_s
     rod_t[c] = t
     rod_k[c] = k
-    rod_f[c, 0] = -f0
-    rod_f[c, 1] = -f1
-    rod_f[c, 2] = -f2
+    rod_f[c, 0] = -(fn * n0 - ft * t0)
+    rod_f[c, 1] = -(fn * n1 - ft * t1)
+    rod_f[c, 2] = -(fn * n2 - ft * t2)
     return energy, p_damp, p_fric, 1, fn
 
 
-def _contact_forces(xs, vs, ms, fixed_s, held_n, xr, vr, mr, seg, nodes, ptr, cand, radius, offset, k_free, k_held,
-                    zeta, mu, v_slip, dt, fs, rod_seg, rod_t, rod_k, rod_f, damp_f, fric_f):
-    """Penalty contact forces on the candidate wall nodes (added into ``fs``) and the reactions on
-    the rod per candidate (``rod_seg`` = -1 if not in contact, ``rod_t``, ``rod_k`` the penalty
-    used, ``rod_f``); the damping and friction parts of the force on the wall node go to
-    ``damp_f`` and ``fric_f``. Free wall nodes get the penalty ``k_free``, held ones ``k_held``.
+def _contact_forces(xs, vs, ms, fixed_s, pn, pw, ps, held_n, xr, vr, mr, seg, points, ptr, cand, radius, offset,
+                    k_free, k_held, zeta, mu, v_slip, dt, rod_seg, rod_t, rod_k, rod_f, damp_f, fric_f):
+    """Penalty contact forces of the candidate points: the reaction on the rod per candidate
+    (``rod_seg`` = -1 if not in contact, ``rod_t``, ``rod_k`` the penalty used, ``rod_f``; the
+    force on the wall is its opposite, :func:`wall_reactions`); the damping and friction parts of
+    the force on the wall go to ``damp_f`` and ``fric_f``. Free points get the penalty ``k_free``,
+    held ones ``k_held``, each times its share ``ps``.
 
     Returns
     -------
@@ -132,10 +165,10 @@ def _contact_forces(xs, vs, ms, fixed_s, held_n, xr, vr, mr, seg, nodes, ptr, ca
     p_fric = 0.0
     n_active = 0
     normal = 0.0
-    for c in numba.prange(nodes.shape[0]):
-        e, pd, pf, a, fn = _contact_one(c, xs, vs, ms, fixed_s, held_n, xr, vr, mr, seg, nodes, ptr, cand, radius,
-                                        offset, k_free, k_held, zeta, mu, v_slip, dt, fs, rod_seg, rod_t, rod_k,
-                                        rod_f, damp_f, fric_f)
+    for c in numba.prange(points.shape[0]):
+        e, pd, pf, a, fn = _contact_one(c, xs, vs, ms, fixed_s, pn, pw, ps, held_n, xr, vr, mr, seg, points, ptr,
+                                        cand, radius, offset, k_free, k_held, zeta, mu, v_slip, dt, rod_seg, rod_t,
+                                        rod_k, rod_f, damp_f, fric_f)
         energy += e
         p_damp += pd
         p_fric += pf
@@ -147,27 +180,43 @@ def _contact_forces(xs, vs, ms, fixed_s, held_n, xr, vr, mr, seg, nodes, ptr, ca
 contact_kernel, contact_kernel_serial = threaded_and_serial(_contact_forces)
 
 
+@numba.njit(cache=True)
+def wall_reactions(points, pn, pw, rod_seg, rod_f, fs):
+    """Add the contact forces of the active candidate points onto the wall nodes they rest on
+    (``fs``), by their weights (serial: points share nodes)."""
+    for c in range(points.shape[0]):
+        if rod_seg[c] < 0:
+            continue
+        q = points[c]
+        for j in range(pn.shape[1]):
+            i = pn[q, j]
+            w = pw[q, j]
+            fs[i, 0] += w * -rod_f[c, 0]
+            fs[i, 1] += w * -rod_f[c, 1]
+            fs[i, 2] += w * -rod_f[c, 2]
+
+
 @numba.njit(cache=True, inline="always")
-def _active_pair(c, seg, nodes, rod_seg, rod_t):
-    """(in contact, wall node, segment's first and second node, fraction t along it) of candidate c."""
+def _active_pair(c, seg, points, rod_seg, rod_t):
+    """(in contact, contact point, segment's first and second node, fraction t along it) of candidate c."""
     s = rod_seg[c]
     if s < 0:
         return False, 0, 0, 0, 0.0
-    return True, nodes[c], seg[s, 0], seg[s, 1], rod_t[c]
+    return True, points[c], seg[s, 0], seg[s, 1], rod_t[c]
 
 
 @numba.njit(cache=True)
-def dissipation_rates(vs, vr, seg, nodes, rod_seg, rod_t, damp_f, fric_f):
+def dissipation_rates(vs, vr, seg, points, pn, pw, rod_seg, rod_t, damp_f, fric_f):
     """Power (W, >= 0) taken out by the stored damping and friction forces at velocities vs, vr
     (serial: a few flops per contact)."""
     p_damp = 0.0
     p_fric = 0.0
-    for c in range(nodes.shape[0]):
-        active, i, a, b, t = _active_pair(c, seg, nodes, rod_seg, rod_t)
+    for c in range(points.shape[0]):
+        active, q, a, b, t = _active_pair(c, seg, points, rod_seg, rod_t)
         if not active:
             continue
         for k in range(3):
-            u = vs[i, k] - ((1.0 - t) * vr[a, k] + t * vr[b, k])
+            u = gather(vs, pn, pw, q, k) - ((1.0 - t) * vr[a, k] + t * vr[b, k])
             p_damp -= damp_f[c, k] * u
             p_fric -= fric_f[c, k] * u
     return p_damp, p_fric
@@ -205,28 +254,31 @@ def rod_reactions(seg, rod_seg, rod_t, rod_k, rod_f, mr, fr, load):
 
 
 @numba.njit(cache=True)
-def contact_spring_action(xs, xr, seg, nodes, rod_seg, rod_t, rod_k, fixed_s, held_n, scale, us, ur, out_s, out_r):
+def contact_spring_action(xs, xr, seg, points, pn, pw, rod_seg, rod_t, rod_k, fixed_s, held_n, scale, us, ur, out_s,
+                          out_r):
     """Add the active penalty springs' K u into ``out_s`` (wall) and ``out_r`` (scope): for
-    candidate c in contact (``rod_seg[c]`` >= 0), wall node i, the scope point p = (1 - t) x_a + t x_b,
-    the normal n from p to the node (a held node's rest normal ``held_n[i]`` when it is nonzero),
-    the relative displacement d = u_i - ((1 - t) u_a + t u_b) (u_i = 0 for a held node) and the
-    spring force ``scale * k (n . d) n``, split linearly onto the segment's nodes."""
-    for c in range(nodes.shape[0]):
-        active, i, a, b, t = _active_pair(c, seg, nodes, rod_seg, rod_t)
+    candidate c in contact (``rod_seg[c]`` >= 0), contact point q, the scope point
+    p = (1 - t) x_a + t x_b, the normal n from p to the point (a held point's rest normal
+    ``held_n[q]`` when it is nonzero), the relative displacement d = u_q - ((1 - t) u_a + t u_b)
+    (u_q interpolated from its nodes, 0 for a held point) and the spring force
+    ``scale * k (n . d) n``, split onto the point's nodes by their weights and linearly onto the
+    segment's nodes."""
+    for c in range(points.shape[0]):
+        active, q, a, b, t = _active_pair(c, seg, points, rod_seg, rod_t)
         if not active:
             continue
-        held = fixed_s[i] != 0
+        held = point_held(fixed_s, pn, q)
         n0 = 0.0
         n1 = 0.0
         n2 = 0.0
-        if held and (held_n[i, 0] != 0.0 or held_n[i, 1] != 0.0 or held_n[i, 2] != 0.0):
-            n0 = held_n[i, 0]
-            n1 = held_n[i, 1]
-            n2 = held_n[i, 2]
+        if held and (held_n[q, 0] != 0.0 or held_n[q, 1] != 0.0 or held_n[q, 2] != 0.0):
+            n0 = held_n[q, 0]
+            n1 = held_n[q, 1]
+            n2 = held_n[q, 2]
         else:
-            n0 = xs[i, 0] - ((1.0 - t) * xr[a, 0] + t * xr[b, 0])
-            n1 = xs[i, 1] - ((1.0 - t) * xr[a, 1] + t * xr[b, 1])
-            n2 = xs[i, 2] - ((1.0 - t) * xr[a, 2] + t * xr[b, 2])
+            n0 = gather(xs, pn, pw, q, 0) - ((1.0 - t) * xr[a, 0] + t * xr[b, 0])
+            n1 = gather(xs, pn, pw, q, 1) - ((1.0 - t) * xr[a, 1] + t * xr[b, 1])
+            n2 = gather(xs, pn, pw, q, 2) - ((1.0 - t) * xr[a, 2] + t * xr[b, 2])
             norm = math.sqrt(n0 * n0 + n1 * n1 + n2 * n2)
             if norm == 0.0:
                 continue
@@ -237,14 +289,17 @@ def contact_spring_action(xs, xr, seg, nodes, rod_seg, rod_t, rod_k, fixed_s, he
         d1 = -((1.0 - t) * ur[a, 1] + t * ur[b, 1])
         d2 = -((1.0 - t) * ur[a, 2] + t * ur[b, 2])
         if not held:
-            d0 += us[i, 0]
-            d1 += us[i, 1]
-            d2 += us[i, 2]
+            d0 += gather(us, pn, pw, q, 0)
+            d1 += gather(us, pn, pw, q, 1)
+            d2 += gather(us, pn, pw, q, 2)
         g = scale * rod_k[c] * (n0 * d0 + n1 * d1 + n2 * d2)
         if not held:
-            out_s[i, 0] += g * n0
-            out_s[i, 1] += g * n1
-            out_s[i, 2] += g * n2
+            for j in range(pn.shape[1]):
+                i = pn[q, j]
+                w = pw[q, j]
+                out_s[i, 0] += w * (g * n0)
+                out_s[i, 1] += w * (g * n1)
+                out_s[i, 2] += w * (g * n2)
         out_r[a, 0] -= (1.0 - t) * g * n0
         out_r[a, 1] -= (1.0 - t) * g * n1
         out_r[a, 2] -= (1.0 - t) * g * n2

@@ -204,3 +204,88 @@ def friction_sliding(friction=0.3, normal=1.0) -> tuple[Comparison, Comparison]:
     return (Comparison("slide: acceleration (F_t - mu N) / M at F_t = 2 mu N", (ft - friction * normal) / s.mass,
                        (s.v5 - s.v2) / s.interval, "m/s^2"),
             Comparison("slide: friction work mu N x slid distance", friction * normal * s.slid, s.dissipated, "J"))
+
+
+# --- where the contact samples the wall: nodes or faces (docs/model.md, "Contact") ----------------
+
+ACROSS_MESH_H = 3e-3  # m, the colon models' wall triangles
+ACROSS_MESH_LOAD = 0.5  # N on the tip
+
+
+def cap_penalty_load(penetration, radius, pressure):
+    """Normal force of a sphere of ``radius`` (the tip's, plus the wall's offset) sunk
+    ``penetration`` into a flat wall whose every point pushes back with ``pressure`` times its
+    gap as the contact law measures it, along the line from the sphere's centre
+    (R - sqrt(rho^2 + z^2), z = R - penetration): the penalty spread over the surface, in closed
+    form, the integral of that gap over the disc of radius a = sqrt(R^2 - z^2),
+    pi R d^2 - 2 pi d^3 / 3 (d the penetration; the cap's volume, measured vertically, is
+    pi d^2 (3 R - d) / 3, larger by pi d^3 / 3)."""
+    d = penetration
+    return pressure * (math.pi * radius * d * d - 2.0 * math.pi * d**3 / 3.0)
+
+
+def _bisect(force, target, hi):
+    """The depth in [0, hi] at which the increasing ``force(depth)`` reaches ``target``."""
+    lo = 0.0
+    for _ in range(60):
+        mid = 0.5 * (lo + hi)
+        lo, hi = (mid, hi) if force(mid) < target else (lo, mid)
+    return 0.5 * (lo + hi)
+
+
+def _tip_penetrations(surface, subdivision, shifts):
+    """Penetration of the tip of :func:`tip_across_wall_mesh` at each of ``shifts`` (m, over the
+    wall's plane), with the contact sampling the wall at ``surface``; and the continuous penalty's
+    (:func:`cap_penalty_load`)."""
+    nodes, tri = flat_sheet(0.03, 0.03, ACROSS_MESH_H)
+    wall = Shell(nodes, tri, WALL_T, reference_material(), name="wall")
+    down = np.tile((0.0, 0.0, -1.0), (len(nodes), 1))  # the wall's normal, away from the scope
+    rod = Rod.straight(0.03, SCOPE_D, SCOPE_E, SCOPE_RHO, spacing=5e-3, start=(0.015, 0.015, 0.04),
+                       direction=(0.0, 0.0, -1.0))
+    free = RodShellContact(rod, wall).stiffness
+    contact = RodShellContact(rod, wall, damping_ratio=1.0, held_normals=down, surface=surface,
+                              face_subdivision=subdivision, held_stiffness=free)
+    sim = ExplicitSolver([rod, wall], contacts=[contact])
+    scope, sheet = sim.state["scope"], sim.state["wall"]
+    sheet.fixed[:] = 1
+    reach = 0.5 * SCOPE_D + 0.5 * WALL_T
+    tip = rod.tip_node
+
+    def normal_force(shift, depth):
+        scope.x[:] = rod.x0
+        scope.x[:, :2] += shift
+        scope.x[:, 2] += reach - depth - rod.x0[tip, 2]
+        sheet.f_con[:] = 0.0
+        scope.f_con[:] = 0.0
+        contact.compute(sim.state, 1e-6)
+        return contact.normal_force
+
+    sunk = np.array([_bisect(lambda z, s=s: normal_force(s, z), ACROSS_MESH_LOAD, 0.5 * reach) for s in shifts])
+    area = 0.5 * np.linalg.norm(np.cross(nodes[tri[:, 1]] - nodes[tri[:, 0]], nodes[tri[:, 2]] - nodes[tri[:, 0]]),
+                                axis=1)
+    lumped = np.zeros(len(nodes))
+    np.add.at(lumped, tri.ravel(), np.repeat(area / 3.0, 3))
+    pressure = free / float(np.median(lumped))  # the interior nodes' area (edge nodes have less)
+    return sunk, _bisect(lambda z: cap_penalty_load(z, reach, pressure), ACROSS_MESH_LOAD, 0.5 * reach)
+
+
+def tip_across_wall_mesh(subdivision=2, positions=40, seed=0) -> Comparison:
+    """The scope's hemispherical tip pressed with :data:`ACROSS_MESH_LOAD` on a flat wall of 3 mm
+    triangles (the colon models' mesh) at ``positions`` random places over one element: its
+    penetration at each, found by bisection on the static contact force, with the contact on the
+    wall's faces (``subdivision`` L, L^2 points per triangle) and on its nodes. The wall is held,
+    its points pushing along its normal, with the penalty of a free wall node (the mobile colon's).
+
+    Returns a :class:`Comparison` of the mean penetration on the faces against that of the same
+    penalty spread over the wall's surface (:func:`cap_penalty_load`, the pressure being one
+    node's penalty over its lumped area), with the spread of the penetration over the positions
+    (m), how far the tip rises and sinks as it slides over the mesh, on the faces ("ripple") and
+    on the nodes ("ripple at the nodes"), and the nodes' mean over the closed form ("nodes' mean /
+    closed form")."""
+    shifts = np.random.default_rng(seed).uniform(0.0, ACROSS_MESH_H, (positions, 2))
+    faces, continuous = _tip_penetrations("faces", subdivision, shifts)
+    at_nodes, _ = _tip_penetrations("nodes", 1, shifts)
+    return Comparison(f"tip across the wall's mesh, contact on its faces ({subdivision ** 2} points per triangle): "
+                      f"mean penetration under {ACROSS_MESH_LOAD:g} N", continuous, float(faces.mean()), "m",
+                      extra={"ripple": float(np.ptp(faces)), "ripple at the nodes": float(np.ptp(at_nodes)),
+                             "nodes' mean / closed form": float(at_nodes.mean()) / continuous})

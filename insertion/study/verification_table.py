@@ -15,7 +15,7 @@ from colonsim.identification.verification import (clamped_grips_check, membrane_
 from colonsim.insertion.study.law_checks import CHECK_MATERIALS, inflated_section, uniaxial_formula, uniaxial_patch
 from colonsim.insertion.study.verification_contact import (damped_push_balance, free_vibration_energy_drift,
                                                            friction_stick, friction_sliding, rod_resting_on_wall,
-                                                           tip_on_node)
+                                                           tip_across_wall_mesh, tip_on_node)
 from colonsim.insertion.study.verification_damping import (axial_damping_decay, lateral_damping_decay, lip_cantilever,
                                                            sliding_push_force)
 from colonsim.insertion.study.verification_resistance import above_euler, below_euler, creep
@@ -218,6 +218,15 @@ CHECKS: tuple[Check, ...] = (
           "a short rod guided along its axis (a sheath over its whole length) pushed tip-down on one wall node: its "
           "neighbours, 5 mm aside, are 1.5 mm clear of the 7.4 mm sphere, so the tip sinks F / k into that node; the "
           "residual is the relaxation of the critically damped contact spring"),
+    Check("contact.faces", "contact", "tip across a wall of 3 mm triangles at 40 places, contact on its faces (4 "
+          "points per triangle): mean penetration against the penalty spread over the surface (closed form)",
+          Run(tip_across_wall_mesh), (Relative(0.005), Bound(upper=2e-5, of="ripple"),
+                                      Bound(lower=4e-5, of="ripple at the nodes")),
+          "the 4 points per triangle sample the 2.3 mm contact disc about 1.5 mm apart, and the mean over random "
+          "places is the sampled integral's mean, the closed form (measured -0.03 %, the 40 places' standard error "
+          "about 0.15 %); the tip rises and sinks by 0.010 mm as it slides (3 % of its 0.35 mm penetration), "
+          "against 0.069 mm when the contact samples the wall at its nodes (measured; the nodes' mean is 2.4 % "
+          "off the closed form)"),
     # --- friction ---
     Check("friction.stick", "friction", "stick: creep speed v_reg F_t / (mu N) at F_t = mu N / 2",
           Run(friction_stick),
