@@ -9,7 +9,9 @@ p = sum_j w_j x_j, carrying a share s of one node's penalty and mass (docs/model
   sub-triangles (L = ``subdivision``), each standing for A / L^2 of the triangle's area A. Its
   share is that area over the mean lumped area of the triangle's three nodes, so a uniformly
   pressed wall takes the same penalty per unit area as with nodes, and a node's row of the
-  contact stiffness (the time-step bound) stays what one node's spring gave.
+  contact stiffness (the time-step bound) stays what one node's spring gave; next to the wall's
+  edge (an end ring) up to 1.3 times as much, as there a node takes a whole node's penalty on
+  less area (``node_share``, which the bound reads).
 
 Why faces: a node-sampled wall is felt only at its nodes, so a round scope lying across the
 wall sinks between two node columns by about (1/r - 1/R) h^2 / 8 (r the scope's radius, R the
