@@ -10,7 +10,9 @@ insertion (the real run, its end rules and held push included) to a state in mid
 - prints the pieces of the estimate (s): the scope alone, the wall's membrane and hinge bounds,
   the wall alone from a Lanczos eigenvalue of its linearised stiffness (central differences of
   its internal forces, held nodes out), the step the run was using, and the stable step of the
-  global estimate (``time_step_estimate = "global"``, its power iteration run to convergence);
+  global estimate (``time_step_estimate = "global"``, its power iteration run to convergence),
+  and the same with the scope held still: the step the wall and its contact springs alone would
+  stand, the most that subcycling the scope could give the wall (:func:`wall_without_scope`);
 - runs copies of that state at fixed steps of k times the estimate (k = 1.0, 1.1, ... until one
   diverges, ``--steps`` steps each) and prints the largest k that stayed stable and the first
   that diverged (the solver's divergence guard: mechanical energy above 10 times what was put
@@ -94,6 +96,19 @@ def wall_lanczos(shell, x, free):
                        maxiter=5000, v0=np.random.default_rng(0).standard_normal(n))[0][0])
 
 
+def wall_without_scope(solver, scope):
+    """Stable step (s) of the coupled system with every node of ``scope`` held still, by the global
+    estimate's power iteration run to convergence: the wall and the contact springs it shares
+    with the scope (grounded), the step a wall stepped apart from a subcycled scope would need."""
+    state = solver.state[scope]
+    fixed = state.fixed.copy()
+    state.fixed[:] = 1
+    try:
+        return 2.0 / math.sqrt(GlobalTimeStep(first_iterations=500, tolerance=1e-8).omega2(solver))
+    finally:
+        state.fixed[:] = fixed
+
+
 def stable_over(solver, step, n_steps):
     """True if a copy of ``solver`` runs ``n_steps`` fixed steps of ``step`` s without diverging."""
     probe = copy.deepcopy(solver)
@@ -119,6 +134,7 @@ def probe(name, n_steps):
     contact = next(c for c in solver.contacts if isinstance(c, RodShellContact)).frequency_squared()
     scope_w2 = (2.0 / model.rod.critical_time_step(solver.state[model.rod.name].x)) ** 2
     global_w2 = GlobalTimeStep(first_iterations=500, tolerance=1e-8).omega2(solver, floor=scope_w2)
+    wall_alone = wall_without_scope(solver, model.rod.name)
     stable, diverged = None, None
     for k in MULTIPLES:
         if stable_over(solver, k * estimate, n_steps):
@@ -133,7 +149,7 @@ def probe(name, n_steps):
         "wall_hinge_bound_s": 2.0 / math.sqrt(hinges), "wall_lanczos_s": 2.0 / math.sqrt(true_wall),
         "wall_with_contact_bound_s": 2.0 / math.sqrt(membrane + hinges + contact[model.shell.name]),
         "wall_lanczos_with_contact_s": 2.0 / math.sqrt(true_wall + contact[model.shell.name]),
-        "global_estimate_s": 2.0 / math.sqrt(global_w2),
+        "global_estimate_s": 2.0 / math.sqrt(global_w2), "wall_and_springs_scope_held_s": wall_alone,
         "largest_stable_multiple": stable, "first_diverged_multiple": diverged, "steps_per_trial": n_steps,
     }
     print(f"{name} at {solver.time:.3f} s (run and probed in {time.perf_counter() - t0:.0f} s): step in use "
@@ -143,7 +159,9 @@ def probe(name, n_steps):
           f"(bound / Lanczos {row['wall_lanczos_s'] / row['wall_bound_s']:.2f} in the step); with the contact's wall "
           f"term {row['wall_with_contact_bound_s']:.3e} / {row['wall_lanczos_with_contact_s']:.3e} s", flush=True)
     print(f"  the global estimate (power iteration, converged): {row['global_estimate_s']:.3e} s = "
-          f"{row['global_estimate_s'] / estimate:.2f} x the estimate", flush=True)
+          f"{row['global_estimate_s'] / estimate:.2f} x the estimate; with the scope held still (the wall and "
+          f"its contact springs: what a subcycled scope would leave to the wall): {wall_alone:.3e} s = "
+          f"{wall_alone / row['scope_alone_s']:.2f} x the scope's own", flush=True)
     limit = "none diverged" if diverged is None else f"first diverged at {diverged:.1f} x ({diverged * estimate:.3e} s)"
     print(f"  fixed steps over {n_steps} steps: stable up to {stable} x the estimate "
           f"({(stable or 0.0) * estimate:.3e} s), {limit}; the step in use is "

@@ -25,3 +25,29 @@ def test_scatter_alone_gives_a_band_of_departures_and_a_crease_falls_outside_it(
     y = trend + np.random.default_rng(1).normal(0.0, 0.001, DIAMETERS.size)
     departure = np.max(np.abs(smoothness.cubic_fit(DIAMETERS, y)[1]))
     assert departure / 0.001 > band["p95"]
+
+
+def test_the_larger_of_two_cubics_follows_the_crease_a_cubic_cannot(tmp_path):
+    """benchmarks/bench_smoothness.py: the largest deformation as the larger of A and C is judged
+    against the larger of their cubics; a crease fails the plain cubic and passes that, and a
+    departure within A itself fails both."""
+    import pandas as pd
+
+    import bench_smoothness
+
+    a = 0.25 * DIAMETERS - 1.2  # rises through c
+    c = 1.45 + 0.02 * (DIAMETERS - 9.0)
+    table = pd.DataFrame({"scope": [f"{d:g}" for d in DIAMETERS], "status": "ok", "point_A_cm": a, "point_C_cm": c,
+                          "max_deformation_cm": np.maximum(a, c), "final_deformation_cm": c})
+    table.to_parquet(tmp_path / "results.parquet")
+    d, residuals, ranges, crease = bench_smoothness.departures(tmp_path)
+    assert np.allclose(d, DIAMETERS)
+    assert np.abs(residuals["max_deformation_cm"]).max() / ranges["max_deformation_cm"] > 0.02
+    assert np.abs(crease).max() / ranges["max_deformation_cm"] < 1e-9
+    bumped = a.copy()
+    bumped[4] += 0.05  # a step in A at 11 mm
+    table["point_A_cm"] = bumped
+    table["max_deformation_cm"] = np.maximum(bumped, c)
+    table.to_parquet(tmp_path / "results.parquet")
+    _, _, ranges, crease = bench_smoothness.departures(tmp_path)
+    assert np.abs(crease).max() / ranges["max_deformation_cm"] > 0.02
