@@ -6,8 +6,9 @@ folder run with other numerical settings: ``benchmarks/sweeps/smoothness.toml``,
 ``smoothness_faces.toml``, ``smoothness_2mm.toml``) and prints, per folder and output, the
 validation report's measure (the largest departure from the least-squares cubic in the
 diameter, as a share of the output's range; :func:`validation_smoothness.cubic_departures`) and
-the largest deformation against the larger of the cubics of A and C (the crease where one
-overtakes the other, which no single cubic follows); then, per output, the correlation of the
+the largest deformation against the larger of the cubics of A and C
+(:func:`validation_smoothness.larger_of_cubics`: the crease where one overtakes the other, which
+no single cubic follows); then, per output, the correlation of the
 departures between every two folders. A departure that the numerical settings do not move
 (correlation near 1) is the model's own shape; one that changes sign with them is scatter.
 
@@ -25,7 +26,7 @@ import numpy as np
 
 from colonsim.insertion.anatomy.scopes import colonoscope
 from colonsim.insertion.study.sweep import read_results
-from validation_smoothness import CUBIC_OUTPUTS, CUBIC_TOLERANCE, cubic_fit
+from validation_smoothness import CUBIC_OUTPUTS, CUBIC_TOLERANCE, cubic_fit, larger_of_cubics
 
 
 def departures(folder):
@@ -39,8 +40,7 @@ def departures(folder):
     values = {c: table[c].to_numpy(dtype=float)[order] for c, _ in CUBIC_OUTPUTS}
     residuals = {c: cubic_fit(d, y)[1] for c, y in values.items()}
     ranges = {c: float(np.ptp(y)) for c, y in values.items()}
-    fits = {c: values[c] - residuals[c] for c in ("point_A_cm", "point_C_cm")}
-    crease = values["max_deformation_cm"] - np.maximum(fits["point_A_cm"], fits["point_C_cm"])
+    crease = values["max_deformation_cm"] - larger_of_cubics(d, values["point_A_cm"], values["point_C_cm"])
     return d, residuals, ranges, crease
 
 

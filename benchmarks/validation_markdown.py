@@ -313,7 +313,9 @@ def smoothness(section):
              "**Against scope diameter** (`smoothness.toml`: RSJ D36, mu 0, scope 9.0 to 13.5 mm in 0.5 mm steps): "
              "each output's largest departure from the least-squares cubic in the diameter, as a share of the "
              "output's range over the runs. Pass: under 2 %. A regime change a cubic cannot follow shows here as a "
-             "failure, and the figure shows where. Beside it, for scale, the departure against the runs' own "
+             "failure, and the figure shows where; the largest deformation, the larger of A and C, is judged "
+             "against the larger of their cubics too (the crease where one overtakes the other, docs/model.md "
+             "\"What makes the outputs rough\"). Beside it, for scale, the departure against the runs' own "
              "scatter about a smooth trend (the noise sd the surrogate fitted on both GP sweeps estimates, table "
              "below): 2 % of a small range can lie below the scatter." + _scatter_alone(section["cubic"]), ""]
     cubic = section["cubic"]
