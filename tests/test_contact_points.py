@@ -51,7 +51,7 @@ def test_node_points_are_the_nodes():
     assert np.all(pts.weights == 1.0) and np.all(pts.share == 1.0) and np.all(pts.node_share == 1.0)
 
 
-@pytest.mark.parametrize("bad", [0, 9, 2.0, "2"])
+@pytest.mark.parametrize("bad", [0, 9, 2.0, "2", True])
 def test_a_bad_subdivision_is_one_line(bad):
     nodes, tri = flat_sheet(0.01, 0.01, 3e-3)
     with pytest.raises(ColonsimError, match="must be a whole number from 1 to 8"):

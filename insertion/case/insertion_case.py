@@ -20,7 +20,7 @@ from colonsim.insertion.anatomy.colon_segments import check_patient_tube
 from colonsim.insertion.anatomy.patient_centerline import SMOOTHING_MM, load_patient_centerline
 from colonsim.insertion.anatomy.scopes import colonoscope
 from colonsim.insertion.case.case_material import case_material
-from colonsim.insertion.engine.contact_points import WALL_SAMPLINGS
+from colonsim.insertion.engine.contact_points import FACE_SUBDIVISIONS, WALL_SAMPLINGS, valid_subdivision
 
 # cases that do not use them stay what they were (existing sweep folders resume).
 LATER_FIELDS = ("centerline", "centerline_smoothing_mm", "material_parameters", "failure_stretch")
@@ -218,9 +218,10 @@ class InsertionCase:
         if self.contact_surface not in WALL_SAMPLINGS:
             raise ColonsimError(f"contact_surface = {self.contact_surface!r} is not one of "
                                 f"{', '.join(WALL_SAMPLINGS)}; give \"nodes\" or \"faces\"")
-        if not (isinstance(self.contact_face_subdivision, int) and 1 <= self.contact_face_subdivision <= 8):
+        if not valid_subdivision(self.contact_face_subdivision):
             raise ColonsimError(f"contact_face_subdivision = {self.contact_face_subdivision!r} is not a whole number "
-                                "from 1 to 8; give the points per triangle edge (2)")
+                                f"from {FACE_SUBDIVISIONS.start} to {FACE_SUBDIVISIONS.stop - 1}; give the points per "
+                                f"triangle edge ({InsertionCase.contact_face_subdivision})")
         if 0.0 < self.relax_max_s < self.relax_s:
             raise ColonsimError(f"relax_max_s = {self.relax_max_s:g} s is shorter than relax_s = {self.relax_s:g} s; "
                                 "give at least relax_s, or 0 for a relax of relax_s")

@@ -34,6 +34,13 @@ import numpy as np
 from colonsim.errors import ColonsimError
 
 WALL_SAMPLINGS = ("nodes", "faces")
+FACE_SUBDIVISIONS = range(1, 9)  # L: beyond 8 (64 points a triangle) the points cost more than they smooth
+
+
+def valid_subdivision(subdivision) -> bool:
+    """Is ``subdivision`` a whole number in :data:`FACE_SUBDIVISIONS`?"""
+    return isinstance(subdivision, (int, np.integer)) and not isinstance(subdivision, bool) \
+        and subdivision in FACE_SUBDIVISIONS
 
 
 @dataclass(frozen=True)
@@ -94,8 +101,9 @@ def face_points(x0, triangles, subdivision, held_normal) -> ContactPoints:
     subdivision : int >= 1, L: L^2 points per triangle, spaced about h / L
     held_normal : (n, 3) the wall's rest normals at its nodes (zeros: none)
     """
-    if not (isinstance(subdivision, (int, np.integer)) and 1 <= subdivision <= 8):
-        raise ColonsimError(f"contact face subdivision = {subdivision!r} must be a whole number from 1 to 8; fix it.")
+    if not valid_subdivision(subdivision):
+        raise ColonsimError(f"contact face subdivision = {subdivision!r} must be a whole number from "
+                            f"{FACE_SUBDIVISIONS.start} to {FACE_SUBDIVISIONS.stop - 1}; fix it.")
     x0 = np.asarray(x0, dtype=np.float64)
     tri = np.asarray(triangles, dtype=np.int64)
     area = 0.5 * np.linalg.norm(np.cross(x0[tri[:, 1]] - x0[tri[:, 0]], x0[tri[:, 2]] - x0[tri[:, 0]]), axis=1)
