@@ -54,12 +54,15 @@ def gather(values, pn, pw, q, k):
 
 
 @numba.njit(cache=True, inline="always")
-def point_held(fixed_s, pn, q):
-    """Is point q held (every node it rests on held at rest)?"""
+def point_held(fixed_s, pn, pw, q):
+    """Is point q held: do the nodes held at rest carry at least half its weight? (A node point:
+    is its node held.) On the seam between the fixed and the mobile wall, the points nearer the
+    held nodes are then the rigid wall's, as the held nodes are."""
+    held = 0.0
     for j in range(pn.shape[1]):
-        if fixed_s[pn[q, j]] == 0:
-            return False
-    return True
+        if fixed_s[pn[q, j]] != 0:
+            held += pw[q, j]
+    return held >= 0.5
 
 
 @numba.njit(cache=True, inline="always")  # a call per point would cost more than its work
@@ -90,7 +93,7 @@ def _contact_one(c, xs, vs, ms, fixed_s, pn, pw, ps, held_n, xr, vr, mr, seg, po
     a = seg[best_s, 0]
     b = seg[best_s, 1]
     t = best_t
-    held = point_held(fixed_s, pn, q)
+    held = point_held(fixed_s, pn, pw, q)
     if held and (held_n[q, 0] != 0.0 or held_n[q, 1] != 0.0 or held_n[q, 2] != 0.0):
         # a point of the rigid fixed wall: it pushes along that wall's normal at rest
         n0 = held_n[q, 0]
@@ -267,7 +270,7 @@ def contact_spring_action(xs, xr, seg, points, pn, pw, rod_seg, rod_t, rod_k, fi
         active, q, a, b, t = _active_pair(c, seg, points, rod_seg, rod_t)
         if not active:
             continue
-        held = point_held(fixed_s, pn, q)
+        held = point_held(fixed_s, pn, pw, q)
         n0 = 0.0
         n1 = 0.0
         n2 = 0.0

@@ -20,9 +20,12 @@ it lies on a column. Sliding and rolling over the mesh, it therefore rises and s
 a millimetre at the mesh's period, which shows as ringing and as a scatter of the outputs from run
 to run. Sampled at spacing h / L over the faces, the sag falls as 1 / L^2.
 
-A point is **held** when every node it rests on is held (the rigid fixed wall: it pushes along
-the wall's rest normal, interpolated and normalised); a point with a free node is free, and its
-force on any held node is taken by that node's constraint.
+A point is **held** when held nodes carry at least half its weight (the rigid fixed wall: it
+pushes along the wall's rest normal, interpolated and normalised, and loads the scope alone);
+otherwise it is free, and its force on any held node is taken by that node's constraint. On the
+seam between the fixed and the mobile wall the points nearer the held nodes are so the rigid
+wall's, as the held nodes are at ``nodes``: pushing along the axis-to-point line there, a tip
+pressed into the crease would be pushed back along its own axis (docs/model.md, "Contact").
 """
 
 from __future__ import annotations
