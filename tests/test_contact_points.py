@@ -5,6 +5,7 @@ import numpy as np
 import pytest
 
 from colonsim.errors import ColonsimError
+from colonsim.insertion.engine.contact_kernel import point_held
 from colonsim.insertion.engine.contact_points import face_points, node_points, subdivision_centroids
 from colonsim.insertion.engine.sheet_mesh import flat_sheet
 
@@ -56,3 +57,33 @@ def test_a_bad_subdivision_is_one_line(bad):
     nodes, tri = flat_sheet(0.01, 0.01, 3e-3)
     with pytest.raises(ColonsimError, match="must be a whole number from 1 to 8"):
         face_points(nodes, tri, bad, np.zeros_like(nodes))
+
+
+@pytest.mark.parametrize("held_nodes, held_points", [
+    ((), set()),
+    ((0,), {"corner 0"}),  # weight 2/3 on node 0; the others carry 1/6 or 1/3 of it
+    ((0, 1), {"corner 0", "corner 1", "middle"}),  # 5/6, 5/6 and 2/3; corner 2 only 1/3
+    ((0, 1, 2), {"corner 0", "corner 1", "corner 2", "middle"}),
+])
+def test_a_face_point_is_held_when_held_nodes_carry_half_its_weight(held_nodes, held_points):
+    """The seam between the fixed and the mobile wall (docs/model.md, "Contact"): the points
+    nearer the held nodes are the rigid wall's, as the held nodes are in the node contact (the
+    rule before c15e92d, every node held, would leave all four free until the third is held)."""
+    nodes = np.array([[0.0, 0.0, 0.0], [3e-3, 0.0, 0.0], [0.0, 3e-3, 0.0]])
+    pts = face_points(nodes, np.array([[0, 1, 2]]), 2, np.tile((0.0, 0.0, -1.0), (3, 1)))
+    fixed = np.zeros(3, dtype=np.uint8)
+    fixed[list(held_nodes)] = 1
+    names = {}
+    for q in range(len(pts)):
+        w = dict(zip(pts.nodes[q], pts.weights[q]))
+        heaviest = max(w, key=w.get)
+        names[q] = "middle" if np.isclose(max(w.values()), 1.0 / 3.0) else f"corner {heaviest}"
+    assert sorted(names.values()) == ["corner 0", "corner 1", "corner 2", "middle"]
+    held = {names[q] for q in range(len(pts)) if point_held(fixed, pts.nodes, pts.weights, q)}
+    assert held == held_points
+
+
+def test_a_node_point_is_held_when_its_node_is():
+    pts = node_points(4, np.zeros((4, 3)))
+    fixed = np.array([0, 1, 0, 1], dtype=np.uint8)
+    assert [point_held(fixed, pts.nodes, pts.weights, q) for q in range(4)] == [False, True, False, True]
