@@ -51,21 +51,10 @@ def cubic_departures(sweep, figure_path):
         y = runs[column].to_numpy(dtype=float)[order]
         keep = np.isfinite(y)
         if keep.sum() < 5:
-            rows.append({"output": label, "column": column, "runs": int(keep.sum()), "departure": math.nan,
-                         "passed": None})
+            rows.append(_too_few_row(label, column, keep))
             continue
         coef, residual = cubic_fit(d[keep], y[keep])
-        spread = float(np.ptp(y[keep]))
-        # an output that stays below 0.1 cm everywhere has no range to judge against (nothing
-        # measurable, as in the claims: insertion/study/claims.py NO_DEFORMATION_CM)
-        judged = float(np.abs(y[keep]).max()) >= NO_DEFORMATION_CM and spread > 0
-        departure_cm = float(np.max(np.abs(residual)))
-        departure = departure_cm / spread if judged else math.nan
-        worst = float(d[keep][np.argmax(np.abs(residual))])
-        rows.append({"output": label, "column": column, "runs": int(keep.sum()), "range": spread,
-                     "departure": departure, "departure_cm": departure_cm if judged else math.nan,
-                     "at_scope_mm": worst if judged else None,
-                     "passed": bool(departure < CUBIC_TOLERANCE) if judged else None})
+        rows.append(_departure_row(label, column, d[keep], y[keep], residual))
         curves.append((label, d[keep], y[keep], coef))
     rows.append(_crease_row(runs, order, d))
     _cubic_figure(curves, figure_path)
@@ -92,17 +81,29 @@ def _crease_row(runs, order, d):
     fit = larger_of_cubics(d, a, c)
     keep = np.isfinite(y) & np.isfinite(fit)
     if keep.sum() < 5:
-        return {"output": CREASE_LABEL, "column": "max_deformation_cm", "runs": int(keep.sum()),
-                "departure": math.nan, "passed": None}
-    residual = y[keep] - fit[keep]
-    spread = float(np.ptp(y[keep]))
-    judged = float(np.abs(y[keep]).max()) >= NO_DEFORMATION_CM and spread > 0
+        return _too_few_row(CREASE_LABEL, "max_deformation_cm", keep)
+    return _departure_row(CREASE_LABEL, "max_deformation_cm", d[keep], y[keep], y[keep] - fit[keep])
+
+
+def _too_few_row(label, column, keep):
+    """A row of :func:`cubic_departures` for an output with under 5 finite values (``keep``): no verdict."""
+    return {"output": label, "column": column, "runs": int(keep.sum()), "departure": math.nan, "passed": None}
+
+
+def _departure_row(label, column, d, y, residual):
+    """A row of :func:`cubic_departures`: the largest departure ``residual`` of the output ``y``
+    (finite values, at scope diameters ``d``, mm) from its smooth fit, over ``y``'s range, and the
+    verdict against :data:`CUBIC_TOLERANCE`."""
+    spread = float(np.ptp(y))
+    # an output that stays below 0.1 cm everywhere has no range to judge against (nothing
+    # measurable, as in the claims: insertion/study/claims.py NO_DEFORMATION_CM)
+    judged = float(np.abs(y).max()) >= NO_DEFORMATION_CM and spread > 0
     departure_cm = float(np.max(np.abs(residual)))
-    return {"output": CREASE_LABEL, "column": "max_deformation_cm", "runs": int(keep.sum()), "range": spread,
-            "departure": departure_cm / spread if judged else math.nan,
-            "departure_cm": departure_cm if judged else math.nan,
-            "at_scope_mm": float(d[keep][np.argmax(np.abs(residual))]) if judged else None,
-            "passed": bool(departure_cm / spread < CUBIC_TOLERANCE) if judged else None}
+    departure = departure_cm / spread if judged else math.nan
+    return {"output": label, "column": column, "runs": int(y.size), "range": spread,
+            "departure": departure, "departure_cm": departure_cm if judged else math.nan,
+            "at_scope_mm": float(d[np.argmax(np.abs(residual))]) if judged else None,
+            "passed": bool(departure < CUBIC_TOLERANCE) if judged else None}
 
 
 def cubic_fit(d, y):
