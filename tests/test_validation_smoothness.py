@@ -51,3 +51,30 @@ def test_the_larger_of_two_cubics_follows_the_crease_a_cubic_cannot(tmp_path):
     table.to_parquet(tmp_path / "results.parquet")
     _, _, ranges, crease = bench_smoothness.departures(tmp_path)
     assert np.abs(crease).max() / ranges["max_deformation_cm"] > 0.02
+
+
+def test_the_report_row_of_the_crease_passes_a_crease_and_fails_a_step(tmp_path):
+    """The validation report's row (cubic_departures, CREASE_LABEL): the larger of A and C passes
+    against the larger of their cubics while the plain cubic fails it; a step in A fails both."""
+    import pandas as pd
+
+    from validation_sweeps import Sweep
+
+    a = 0.25 * DIAMETERS - 1.2
+    c = 1.45 + 0.02 * (DIAMETERS - 9.0)
+
+    def rows(a):
+        table = pd.DataFrame({"key": [f"run{i}" for i in range(DIAMETERS.size)], "scope": [f"{d:g}" for d in DIAMETERS],
+                              "status": "ok", "point_A_cm": a, "point_C_cm": c, "max_deformation_cm": np.maximum(a, c),
+                              "final_deformation_cm": c})
+        out = smoothness.cubic_departures(Sweep("smoothness", tmp_path, [], table, True), tmp_path / "cubic.png")
+        return {r["output"]: r for r in out["rows"]}
+
+    crease = rows(a)
+    assert crease["max [cm]"]["passed"] is False
+    assert crease[smoothness.CREASE_LABEL]["passed"] is True
+    bumped = a.copy()
+    bumped[4] += 0.05  # a step in A at 11 mm
+    step = rows(bumped)
+    assert step[smoothness.CREASE_LABEL]["passed"] is False and step["max [cm]"]["passed"] is False
+    assert step[smoothness.CREASE_LABEL]["at_scope_mm"] == 11.0
