@@ -25,13 +25,10 @@ import argparse
 import sys
 from pathlib import Path
 
-from colonsim.insertion.case.insertion_case import InsertionCase
-from colonsim.insertion.study.sweep_presets import HALF_SPEED
-
 import validation_smoothness as smoothness
 from validation_markdown import mesh_pair, rate_check
 from validation_markdown import smoothness as smoothness_section
-from validation_report import pair_section
+from validation_report import pair_section, rate_section
 from validation_sweeps import TABLE, read_sweep
 
 FOLDERS = ("base", "variants", "smoothness", "gp_train", "gp_test")
@@ -69,19 +66,14 @@ def main(argv=None):
     if args.base:
         base, variants = read_sweep("main", args.base), read_sweep("validation", args.variants)
         print("\n".join(mesh_pair(pair_section(variants, base, "mesh"))))
-        print("\n".join(rate_check({**pair_section(variants, base, "rate"),
-                                    "speeds": (InsertionCase().push_speed, HALF_SPEED),
-                                    "held_share": InsertionCase().held_push_share,
-                                    "held_lead_mm": InsertionCase().held_push_lead_mm})))
+        print("\n".join(rate_check(rate_section(variants, base))))
     if args.smoothness or args.gp_train:
         smooth = read_sweep("smoothness", args.smoothness, optional=True)
         train = read_sweep("gp_train", args.gp_train, optional=True)
         test = read_sweep("gp_test", args.gp_test, optional=True)
         figure = Path(args.figures or args.smoothness or ".") / "smoothness.png"
         figure.parent.mkdir(parents=True, exist_ok=True)
-        print("\n".join(smoothness_section({"cubic": smoothness.cubic_departures(smooth, figure),
-                                            "figure": str(figure),
-                                            "surrogate": smoothness.surrogate_holdout(train, test)})))
+        print("\n".join(smoothness_section(smoothness.section(smooth, train, test, figure, str(figure)))))
     return 0
 
 

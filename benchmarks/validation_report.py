@@ -136,6 +136,16 @@ def pair_section(validation, main, check):
     return {"ran": True, "rows": rows, "summary": summary}
 
 
+def rate_section(validation, main, angles=None):
+    """The rate check's section: its pairs (:func:`pair_section`), the two push speeds and the held
+    push's share and lead; with ``angles`` (a sweep of further half-speed runs), their pairs too."""
+    section = {**pair_section(validation, main, "rate"), "speeds": (InsertionCase().push_speed, HALF_SPEED),
+               "held_share": InsertionCase().held_push_share, "held_lead_mm": InsertionCase().held_push_lead_mm}
+    if angles is not None:
+        section["angles"] = pair_section(angles, main, "rate")
+    return section
+
+
 def flexure_section(validation, main, out):
     angles = sorted({v.angle_deg for kind, _, v, _ in paired(validation, main) if kind == "flexure"})
     if not validation.ran:
@@ -260,14 +270,9 @@ def main(argv=None):
            "ringing": {"limit": RINGING_LIMIT, "sweeps": {"main": sections.ringing_rows(main_sweep),
                                                           "validation": sections.ringing_rows(validation)}},
            "mesh_pair": pair_section(validation, main_sweep, "mesh"),
-           "rate_check": {**pair_section(validation, main_sweep, "rate"),
-                          "speeds": (InsertionCase().push_speed, HALF_SPEED),
-                          "held_share": InsertionCase().held_push_share,
-                          "held_lead_mm": InsertionCase().held_push_lead_mm,
-                          "angles": pair_section(angles, main_sweep, "rate")},
-           "smoothness": {"cubic": smoothness.cubic_departures(smooth, out / "figures" / "smoothness.png"),
-                          "figure": "figures/smoothness.png",
-                          "surrogate": smoothness.surrogate_holdout(gp_train, gp_test)},
+           "rate_check": rate_section(validation, main_sweep, angles),
+           "smoothness": smoothness.section(smooth, gp_train, gp_test, out / "figures" / "smoothness.png",
+                                            "figures/smoothness.png"),
            "flexure_sensitivity": sensitivity,
            "resistance": resistance_section(resisted, ringing_half, out),
            "node_counts": sections.node_counts(),

@@ -38,6 +38,14 @@ def _ok(table):
     return table[table["status"] == "ok"] if "status" in table else table
 
 
+def section(smooth, train, test, figure_path, figure_link):
+    """The report's smoothness section: the departures from a cubic of the ``smooth`` sweep (figure
+    written to ``figure_path``, cited as ``figure_link``) and the surrogate fitted on ``train``
+    predicting ``test``."""
+    return {"cubic": cubic_departures(smooth, figure_path), "figure": figure_link,
+            "surrogate": surrogate_holdout(train, test)}
+
+
 def cubic_departures(sweep, figure_path):
     """Each output's largest departure from its cubic fit in the scope diameter, over its range."""
     if not sweep.ran:
