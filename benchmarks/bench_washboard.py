@@ -24,7 +24,7 @@ import numpy as np
 import pandas as pd
 
 from colonsim.insertion.case.insertion_case import InsertionCase
-from colonsim.insertion.case.outcomes import ringing_ratio, ringing_wavelength
+from colonsim.insertion.case.ringing import ringing_ratio, ringing_wavelength
 from colonsim.insertion.case.scenario import run_insertion
 
 CASE = {"segment": "rsj", "scope": "11.0", "diameter_mm": 36.0, "friction": 0.0}

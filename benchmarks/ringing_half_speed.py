@@ -22,7 +22,7 @@ from pathlib import Path
 
 from colonsim.errors import ColonsimError
 from colonsim.insertion.case.insertion_case import InsertionCase
-from colonsim.insertion.case.outcomes import RINGING_LIMIT
+from colonsim.insertion.case.ringing import RINGING_LIMIT
 from colonsim.insertion.study.sweep_presets import HALF_SPEED
 from colonsim.insertion.study.sweep_spec import parse_sweep
 from validation_resistance import half_speed_twin, measured_ringing

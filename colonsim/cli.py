@@ -140,9 +140,9 @@ def _add_insert(sub):
                    help=f"plateau push speed, m/s (default {InsertionCase.push_speed:g}, quasi-static; the source "
                         "pushed at 0.6; half of it checks the rate: docs/model.md, \"Loading\")")
     p.add_argument("--time-step-estimate", choices=TIME_STEP_ESTIMATES, default=InsertionCase.time_step_estimate,
-                   help="what the stable time step rests on: bounds (default) or global, the coupled system's "
-                        "largest frequency by power iteration (about 0.7 of the steps; docs/model.md, \"The global "
-                        "time-step estimate\")")
+                   help="what the stable time step rests on: global (default), the coupled system's largest "
+                        "frequency by power iteration (about 0.7 of the steps of bounds), or bounds, the element "
+                        "bounds (docs/quasi_static.md)")
     p.add_argument("--contact-surface", choices=WALL_SAMPLINGS, default=InsertionCase.contact_surface,
                    help="where the contact samples the wall: its nodes (default) or points spread over its triangles, "
                         f"{InsertionCase.contact_face_subdivision ** 2} per triangle (the scope no longer rises and "

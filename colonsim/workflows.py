@@ -365,7 +365,7 @@ def _run_cases(cases, budgets, out, stage, vtu, snapshot_every, show):
         print(f"{case.segment.upper()} {s['scope']['name']:>8}: final deformation {s['final_deformation_cm']:.2f} cm, "
               f"max {s['max_deformation_cm']:.2f} cm ({pts}); peak contact {s['peak_contact_force_N']:.2f} N, "
               f"peak push {s['peak_push_force_N']:.2f} N; {distal_words(s)}; {quasi_static_words(s['quasi_static'])}; "
-              f"{relax_words(s.get('relax'))}{rest_words(s['at_rest'])}; ended: {s['end']['reason']} at "
+              f"{relax_words(s.get('relax'))}{rest_words(s['at_rest'])}; ended_by {s['ended_by']} ({s['end']['reason']}) at "
               f"{s['end']['depth_cm']:.1f} cm; "
               f"{s['steps']} steps in {s['wall_time_s']:.1f} s -> {folder}/")
     table, figure = comparison_table(results), insertion_figure(results)  # both made before either file is replaced

@@ -145,7 +145,7 @@ CASES = [
     (["sweep", "{ws}/not_toml.toml", "--out", "{ws}/sweep_a"], "not valid TOML"),
     (["sweep", "{ws}/typo.toml", "--out", "{ws}/sweep_a"], "did you mean 'segment'?"),
     (["sweep", "{ws}/estimate.toml", "--out", "{ws}/sweep_a"],
-     "time_step_estimate = 'fast' is not one of bounds, global; give \"bounds\" (the default) or \"global\""),
+     "time_step_estimate = 'fast' is not one of bounds, global; give \"global\" (the default) or \"bounds\""),
     (["insert", "--time-step-estimate", "fast", "--out", "{ws}/ins"], "invalid choice: 'fast'"),
     (["sweep", "{ws}/surface.toml", "--out", "{ws}/sweep_a"],
      "contact_surface = 'edges' is not one of nodes, faces; give \"nodes\" or \"faces\""),

@@ -4,8 +4,9 @@ import numpy as np
 import pytest
 
 from colonsim.insertion.case.outcomes import (JAM_FORCE, JAM_PROGRESS, JAM_PUSH, arc_along, characteristic_points, jammed,
-                                              principal_stretches, quasi_static_fraction, ringing_wavelength,
-                                              sliding_kinetic_energy, tip_heading, turned_back)
+                                              principal_stretches, quasi_static_fraction, sliding_kinetic_energy,
+                                              tip_heading, turned_back)
+from colonsim.insertion.case.ringing import ringing_wavelength
 from colonsim.insertion.case.results import distal_words
 
 

@@ -91,7 +91,7 @@ def test_the_half_speed_sweep_holds_the_runs_above_the_limit_and_reads_back_as_t
     failed one and one already at half the speed are not; the TOML parses to the keys the report
     looks up (every input that differs from the defaults, the resistance of 0 N included)."""
     import ringing_half_speed as generator
-    from colonsim.insertion.case.outcomes import RINGING_LIMIT
+    from colonsim.insertion.case.ringing import RINGING_LIMIT
     from colonsim.insertion.study.sweep_spec import parse_sweep
 
     quiet = dataclasses.replace(CASE, angle_deg=45.0)

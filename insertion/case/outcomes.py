@@ -55,8 +55,6 @@ def characteristic_points(time, depth, deformation, prominence=0.05):
     return points
 
 
-RINGING_WINDOW = 0.01  # m of push: the moving average the push force rings about
-RINGING_LIMIT = 0.1  # a run whose ringing ratio is below this is quasi-static (docs/model.md)
 PEAK_WINDOW = 0.005  # m of push: peak forces are maxima of the force averaged over this much push
 # The other quasi-static checks (docs/model.md, "Time integration and damping"), which need more
 # than one run: half the push speed or a 2 mm mesh may change a deformation by this fraction and a
@@ -105,121 +103,6 @@ def peak_trend(depth, values, window=PEAK_WINDOW):
     trend, covered = depth_trend(depth, values, window)
     full = covered >= 0.5 * window
     return float(trend[full].max()) if full.any() else float("nan")
-
-
-def _from_first_contact(depth, push_force, in_contact):
-    """Depth and push force from the first sample in contact on (empty arrays without contact)."""
-    contact = np.asarray(in_contact, dtype=bool)
-    first = int(np.argmax(contact)) if contact.any() else contact.size
-    return np.asarray(depth, dtype=float)[first:], np.asarray(push_force, dtype=float)[first:]
-
-
-def ringing_ratio(depth, push_force, in_contact, window=RINGING_WINDOW):
-    """How much the push force rings about its trend, once contact has begun (docs/model.md,
-    "Time integration and damping").
-
-    The push force is a function of the pushed depth in a quasi-static run. Every sample is
-    weighted by the depth it stands for (:func:`depth_weights`), so the measure is an integral
-    over the push: a pause, when the scope is not advancing (the stop and relax of RSF/THF),
-    weighs nothing, and a run sampled at another push speed measures the same thing. The trend
-    is the force's depth-weighted mean over ``window`` of push (:func:`depth_trend`).
-
-    Parameters
-    ----------
-    depth, push_force : (n,) arrays
-        Pushed depth (m, non-decreasing) and push force (N) per sample.
-    in_contact : (n,) bool array
-        Samples with scope-wall contact; the measure starts at the first.
-    window : float
-        Push distance of the moving average, m (1 cm).
-
-    Returns
-    -------
-    dict with ``ratio`` (RMS about the trend over the mean push force; NaN when the push after
-    first contact is shorter than the window or its mean force is not positive), ``rms_N``,
-    ``mean_N`` and ``push_cm`` (the push distance measured).
-    """
-    z, f = _from_first_contact(depth, push_force, in_contact)
-    empty = {"ratio": float("nan"), "rms_N": float("nan"), "mean_N": float("nan"), "push_cm": 0.0}
-    if z.size < 3 or z[-1] - z[0] < window:
-        return {**empty, "push_cm": float((z[-1] - z[0]) * 100) if z.size else 0.0}
-    w = depth_weights(z)
-    trend, _ = depth_trend(z, f, window)
-    total = float(w.sum())
-    mean = float(np.sum(w * f) / total)
-    rms = float(np.sqrt(np.sum(w * (f - trend) ** 2) / total))
-    ratio = rms / mean if mean > 0.0 else float("nan")
-    return {"ratio": ratio, "rms_N": rms, "mean_N": mean, "push_cm": total * 100}
-
-
-def ringing_wavelength(depth, push_force, in_contact, window=RINGING_WINDOW, step=2e-4):
-    """The push distance over which the push force's ringing repeats most strongly (m).
-
-    The ringing (:func:`ringing_ratio`: the force about its trend over ``window`` of push, from
-    the first contact) resampled every ``step`` of push, pauses left out, and the peak of its
-    periodogram (Hann-windowed) among periods shorter than ``window``. A remainder tied to the
-    discretisation shows here as a fixed push distance whatever the push speed: the scope passing
-    over the wall's nodes repeats every one or two rings of the wall mesh (docs/model.md, "Time
-    integration and damping").
-
-    Returns NaN when under two windows of push were measured after the first contact.
-    """
-    measured = _on_push_grid(depth, push_force, in_contact, window, step)
-    if measured is None:
-        return float("nan")
-    grid, _, residual = measured
-    residual = (residual - residual.mean()) * np.hanning(grid.size)
-    power = np.abs(np.fft.rfft(residual)) ** 2
-    frequency = np.fft.rfftfreq(grid.size, step)  # cycles per m of push
-    shorter = frequency > 1.0 / window
-    if not shorter.any():
-        return float("nan")
-    return float(1.0 / frequency[shorter][np.argmax(power[shorter])])
-
-
-def _on_push_grid(depth, push_force, in_contact, window, step):
-    """The push force after the first contact and its ringing about the trend over ``window``
-    (:func:`ringing_ratio`) resampled every ``step`` of push, pauses left out: the grid (m), the
-    force and the ringing (N); None when under two windows of push were measured."""
-    z, f = _from_first_contact(depth, push_force, in_contact)
-    if z.size < 3 or z[-1] - z[0] < 2.0 * window:
-        return None
-    trend, _ = depth_trend(z, f, window)
-    advancing = np.concatenate(([True], np.diff(z) > 0.0))  # a pause has one depth: keep its first sample
-    grid = np.arange(z[0], z[-1], step)
-    return grid, np.interp(grid, z[advancing], f[advancing]), np.interp(grid, z[advancing], (f - trend)[advancing])
-
-
-def ringing_at_drops(depth, push_force, in_contact, window=RINGING_WINDOW, drop_N=1.0, drop_push=2e-3,
-                     near=6e-3, step=2e-4):
-    """How much of the ringing (:func:`ringing_ratio`) sits at sudden drops of the push force.
-
-    A loop that snaps through drops the push force by newtons within a millimetre or two of push:
-    a step in a force that is otherwise a function of the depth, which the moving average turns
-    into RMS on either side of it without anything oscillating. Here a drop is the force falling
-    by more than ``drop_N`` over ``drop_push`` of push (on the force resampled every ``step``,
-    pauses left out); ``share`` is the fraction of the squared ringing within ``near`` of push of
-    a drop, ``push_share`` the fraction of the push that lies there, ``drops`` the number of
-    separate drops (closer than ``drop_push`` counts as one). An oscillation of the push force
-    about its trend gives a share near ``push_share``; ringing made of steps, a share near 1.
-
-    Returns NaN values (``drops`` 0) when under two windows of push were measured after the
-    first contact.
-    """
-    measured = _on_push_grid(depth, push_force, in_contact, window, step)
-    if measured is None:
-        return {"share": float("nan"), "push_share": float("nan"), "drops": 0}
-    grid, force, residual = measured
-    lag = max(int(round(drop_push / step)), 1)
-    dropping = np.zeros(grid.size, dtype=bool)
-    dropping[lag:] = force[:-lag] - force[lag:] > drop_N
-    reach = int(round(near / step))
-    around = np.convolve(dropping, np.ones(2 * reach + 1), mode="same") > 0.0
-    at = np.flatnonzero(dropping)
-    drops = int(at.size > 0) + int(np.sum(np.diff(at) > lag))
-    total = float(np.sum(residual**2))
-    share = float(np.sum(residual[around] ** 2) / total) if total > 0.0 else float("nan")
-    return {"share": share, "push_share": float(np.mean(around)), "drops": drops}
 
 
 def quasi_static_fraction(kinetic, internal, ratio=0.1, floor=1e-12):

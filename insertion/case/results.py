@@ -19,8 +19,10 @@ import numpy as np
 import pandas as pd
 from matplotlib.figure import Figure
 
+from colonsim.catalog import TIP_FOLDED
 from colonsim.files import atomic_path, save_figure, write_csv, write_json
-from colonsim.insertion.case.outcomes import REST_WINDOW, RINGING_LIMIT
+from colonsim.insertion.case.outcomes import REST_WINDOW
+from colonsim.insertion.case.ringing import RINGING_LIMIT
 
 
 def user_units(ts: pd.DataFrame) -> pd.DataFrame:
@@ -45,8 +47,11 @@ def quasi_static_words(qs: dict) -> str:
     ratio = qs.get("ringing_ratio")
     if ratio is None or not np.isfinite(ratio):
         return "quasi-static check undefined (too little push after the first contact)"
-    verdict = "holds" if qs["holds"] else "does NOT hold"
-    return f"ringing ratio {ratio:.3f} (limit {RINGING_LIMIT:g}): quasi-static {verdict}"
+    verdict = "holds" if qs["holds"] else f"does NOT hold ({qs['cause']})"
+    snaps = qs.get("snap_throughs") or {}
+    left = (f"; {snaps['count']} snap-through(s) at {', '.join(f'{d:.1f}' for d in snaps['depths_cm'])} cm of push, "
+            f"{snaps['left_out_share']:.0%} of the push left out" if snaps.get("count") else "")
+    return f"ringing ratio {ratio:.3f} (limit {RINGING_LIMIT:g}){left}: quasi-static {verdict}"
 
 
 def rest_words(rest: dict) -> str:
@@ -78,7 +83,10 @@ def distal_words(summary: dict) -> str:
     d = summary["distal_resistance"]
     lag = f"scope lag max {summary['max_lag_cm']:.1f} cm, final {summary['final_lag_cm']:.1f} cm"
     back = summary.get("tip_turned_back_cm")
-    if back is not None:
+    if summary.get("ended_by") == TIP_FOLDED:
+        lag += (f"; the run ENDED at {summary['end']['depth_cm']:.1f} cm of push because the tip folded back on itself "
+                "(outside the model: a real tip is steered); its outputs are those up to the fold")
+    elif back is not None:
         lag += (f"; the tip TURNED BACK at {back:.1f} cm of push and stayed so: the final deformation and lag "
                 "describe a fold of the scope, not a loop behind a held tip")
     if not d["acting"]:
@@ -102,6 +110,7 @@ def comparison_table(results) -> pd.DataFrame:
                            "tip_turned_back_cm": r.summary.get("tip_turned_back_cm"),
                            "ringing_ratio": r.summary["quasi_static"]["ringing_ratio"],
                            "quasi_static": r.summary["quasi_static"]["holds"],
+                           "snap_throughs": r.summary["quasi_static"]["snap_throughs"]["count"],
                            "came_to_rest": r.summary["at_rest"]["came_to_rest"],
                            "ended_by": r.summary["ended_by"], "wall_time_s": r.summary["wall_time_s"]}
                           for r in results])

@@ -4,12 +4,14 @@ scalar outcomes, and its quasi-static check.
 
 from __future__ import annotations
 
-from colonsim.catalog import colon_model
+from colonsim.catalog import TIP_FOLDED, colon_model
 from colonsim.insertion.anatomy.manoeuvre import SETTLE
 from colonsim.insertion.case.outcomes import (JAM_FORCE, JAM_PROGRESS, JAM_PUSH, PEAK_WINDOW, REST_TOLERANCE,
-                                              REST_WINDOW, RINGING_LIMIT, RINGING_WINDOW, characteristic_points,
-                                              peak_trend, quasi_static_fraction, rest_drift, ringing_ratio,
-                                              turned_back)
+                                              REST_WINDOW, TURNED_BACK_DEG, characteristic_points, peak_trend,
+                                              quasi_static_fraction, rest_drift, turned_back)
+from colonsim.insertion.case.ringing import (RINGING_FORCE_FLOOR_N, RINGING_LIMIT, RINGING_WINDOW, SNAP_DROP_N,
+                                             SNAP_DROP_PUSH, SNAP_DROP_SHARE, SNAP_LEFT_OUT_LIMIT, SNAP_LEFT_OUT_PUSH,
+                                             ringing_cause, ringing_holds, ringing_ratio)
 from colonsim.insertion.engine.material import REFERENCE_MATERIAL_PATH
 from colonsim.provenance import code_version
 
@@ -18,6 +20,8 @@ ENDINGS = {
     "far_end": "the tip reached the model's far end",
     "length_used": "the scope's available length was pushed in",
     "wall_stretch": "the wall's largest stretch passed the failure stretch",
+    TIP_FOLDED: f"the tip folded back on itself (its last segment more than {TURNED_BACK_DEG:g} deg from the "
+                  "lumen's direction): a real tip is steered, so the run ends there, outside the model",
     "jam": f"the tip jammed: under {JAM_PROGRESS * 1e3:g} mm of tip progress over {JAM_PUSH * 100:g} cm of push "
            f"under a push force of {JAM_FORCE:g} N or more",
 }
@@ -45,20 +49,29 @@ def _finite(value):
 
 
 def quasi_static_summary(ts, energy_fractions, sliding) -> dict:
-    """The run's quasi-static check (docs/model.md, "Time integration and damping"): the ringing
-    ratio of the push force over the push (the closing settle phase left out: the scope is held
-    there), and the kinetic/internal energy fractions as information."""
+    """The run's quasi-static check (docs/quasi_static.md): the ringing ratio of the push force over
+    the push (the closing settle phase left out: the scope is held there) with the snap-throughs it
+    leaves out, and the kinetic/internal energy fractions as information."""
     pushing = (ts["phase"] != SETTLE).to_numpy()
     ring = ringing_ratio(ts["depth_m"].to_numpy()[pushing], ts["push_force_N"].to_numpy()[pushing],
                          ts["contact_nodes"].to_numpy()[pushing] > 0)
     return {
         "criterion": f"ringing ratio below {RINGING_LIMIT:g}: RMS of the push force about its moving average over "
-                     f"{RINGING_WINDOW * 100:g} cm of push, over its mean, from the first contact to the end of the push",
+                     f"{RINGING_WINDOW * 100:g} cm of push, over max(its mean, {RINGING_FORCE_FLOOR_N:g} N), from the "
+                     f"first contact to the end of the push, the {SNAP_LEFT_OUT_PUSH * 1e3:g} mm after each "
+                     f"snap-through left out (at most {SNAP_LEFT_OUT_LIMIT:.0%} of the push)",
         "ringing_ratio": _finite(ring["ratio"]),
         "push_force_rms_N": _finite(ring["rms_N"]),
         "mean_push_force_N": _finite(ring["mean_N"]),
+        "force_floor_N": RINGING_FORCE_FLOOR_N,
         "measured_push_cm": ring["push_cm"],
-        "holds": bool(ring["ratio"] < RINGING_LIMIT),
+        "snap_throughs": {"count": len(ring["snap_throughs"]), "depths_cm": ring["snap_throughs"],
+                          "left_out_share": ring["left_out_share"],
+                          "rule": f"the push force falls by more than {SNAP_DROP_N:g} N and more than "
+                                  f"{SNAP_DROP_SHARE:.0%} of the force before it within {SNAP_DROP_PUSH * 1e3:g} mm "
+                                  "of push"},
+        "holds": ringing_holds(ring),
+        "cause": ringing_cause(ring),
         "energy": {"meaning": "kinetic / internal energy < 10 % on most (> 50 %) of the samples, per body, the scope's "
                               "kinetic energy taken less that of sliding along itself at the push speed; information, "
                               "not the criterion (it passed runs that rang)",

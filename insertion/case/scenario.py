@@ -30,10 +30,12 @@ Modelling choices (stated so they can be cited):
   (``"tip_past_end"``: for RSJ 2 cm past the sigmoid's fixed end; ``"far_end"``: for RSF/THF the
   far end of the fixed exit, beyond which the tip would leave the model), when the available
   length is pushed in (``"length_used"``), when the wall's largest stretch passes
-  ``failure_stretch`` (``"wall_stretch"``), or when the tip jams (``"jam"``,
+  ``failure_stretch`` (``"wall_stretch"``), when the tip folds back on itself (``"tip_folded"``:
+  its last segment more than 90 deg from the lumen's direction; a real tip is steered, so such a
+  run is outside the model and ends at the fold), or when the tip jams (``"jam"``,
   :func:`colonsim.insertion.case.outcomes.jammed`; once the distal resistance has engaged, the
   tip is held back, not jammed, even where it slides back out of the exit's first millimetres).
-  A jam or a torn wall is an outcome: the summary says where and under which forces.
+  A jam, a fold or a torn wall is an outcome: the summary says where and under which forces.
 """
 
 from __future__ import annotations
@@ -44,7 +46,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from colonsim.catalog import CONTINUOUS_PUSH, colon_model
+from colonsim.catalog import CONTINUOUS_PUSH, TIP_FOLDED, colon_model
 from colonsim.errors import ColonsimError
 from colonsim.insertion.anatomy.centerline import TubeClash
 from colonsim.insertion.anatomy.colon_segments import EXIT_LIMIT, colon_geometry
@@ -53,7 +55,7 @@ from colonsim.insertion.anatomy.scopes import colonoscope
 from colonsim.insertion.case.case_material import case_material
 from colonsim.insertion.case.insertion_case import InsertionCase
 from colonsim.insertion.case.lumen_guard import check_scope_inside
-from colonsim.insertion.case.outcomes import REST_TOLERANCE, REST_WINDOW, rest_drift
+from colonsim.insertion.case.outcomes import REST_TOLERANCE, REST_WINDOW, TURNED_BACK_DEG, rest_drift
 from colonsim.insertion.case.recording import InsertionRecorder
 from colonsim.insertion.case.run_summary import end_state, summarize, tip_passed_end
 from colonsim.insertion.engine.constraints import FixedNodes, LineConstraint, PrescribedVelocity
@@ -342,6 +344,8 @@ def run_insertion(case: InsertionCase, progress=None, snapshot_interval=None) ->
             continue
         if last["max_stretch"] > case.failure_stretch:
             ended_by = "wall_stretch"
+        elif last["tip_heading_deg"] > TURNED_BACK_DEG:
+            ended_by = TIP_FOLDED
         elif push.settle_start is not None and model.solver.time >= push.settle_start:
             ended_by = "length_used"
         elif model.solver.time >= push.last_push.start and tip_passed_end(last, model):
@@ -350,8 +354,8 @@ def run_insertion(case: InsertionCase, progress=None, snapshot_interval=None) ->
             ended_by = "jam"
         if ended_by is None:
             continue
-        if ended_by in ("jam", "wall_stretch") or push.settle_start is None:
-            break  # a jam or a tear ends where it happened, under its load; a profile without a settle phase, at its rule
+        if ended_by in ("jam", "wall_stretch", TIP_FOLDED) or push.settle_start is None:
+            break  # a jam, a tear or a fold ends where it happened, under its load; a profile without a settle phase, at its rule
         push.stop(model.solver.time, case.stop_distance_mm * 1e-3, case.settle_max_s)
     ended_by = ended_by or "length_used"
     check_scope_inside(model, recorder.rows[-1]["depth_m"])

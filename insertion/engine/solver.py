@@ -178,15 +178,20 @@ class ExplicitSolver:
         coupled system's largest frequency instead, when it is the longer.
         """
         omega2 = {b.name: (2.0 / b.critical_time_step(self.state[b.name].x)) ** 2 for b in self.bodies}
-        exact = [omega2[b.name] for b in self.bodies if hasattr(b, "max_frequency")]  # a rod's is its eigenvalue
+        floor = [omega2[b.name] for b in self.bodies if hasattr(b, "max_frequency")]  # a rod's is its eigenvalue
         for c in self.contacts:
             c.follow_wall(omega2)
             for name, w2 in c.frequency_squared().items():
                 omega2[name] += w2
+                floor.append(w2)
         bound = 2.0 / math.sqrt(max(omega2.values()))
         if self.global_estimate is None:
             return bound
-        return max(bound, 2.0 / math.sqrt(self.global_estimate.omega2(self, floor=max(exact, default=0.0))))
+        # The power iteration sees the springs active at its last evaluation; a contact that appears
+        # between two updates it cannot see. Each contact's own frequency as the bounds count it
+        # (doubled for contacts appearing before the next update) floors the estimate: without it a
+        # scope snapping along a coarse wall diverged (docs/quasi_static.md, "The time step").
+        return max(bound, 2.0 / math.sqrt(self.global_estimate.omega2(self, floor=max(floor, default=0.0))))
 
     def _update_time_step(self):
         if self.fixed_time_step is not None:

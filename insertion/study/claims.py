@@ -24,7 +24,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import pandas as pd
 
-from colonsim.catalog import NAMED_SCOPES, scope_role
+from colonsim.catalog import NAMED_SCOPES, TIP_FOLDED, scope_role
 from colonsim.errors import ColonsimError
 
 REPRODUCED = "REPRODUCED"
@@ -80,11 +80,14 @@ class _Runs:
         rows = t[mask]
         label = _label(segment, scope, **inputs)
         ok = rows[rows["status"] == "ok"]
+        folded = ok[ok["ended_by"].astype(str) == TIP_FOLDED] if "ended_by" in ok else ok.iloc[:0]
+        ok = ok.drop(folded.index)
         if len(ok) > 1:
             raise ColonsimError(f"the results table holds {len(ok)} successful runs of {label}; "
                                 "evaluate the claims on a table with one run per case")
         if len(ok) == 0:
-            self.missing.append(f"{label} ({'failed' if len(rows) else 'not run'})")
+            why = "its tip folded: outside the model" if len(folded) else "failed" if len(rows) else "not run"
+            self.missing.append(f"{label} ({why})")
             return None
         return float(ok[column].iloc[0])
 

@@ -54,10 +54,13 @@ def _outputs(summary) -> dict:
     # energy check as information
     out["ringing_ratio"] = number(qs.get("ringing_ratio"))
     out["quasi_static"] = bool(qs.get("holds", False))
+    snaps = qs.get("snap_throughs") or {}
+    out["snap_throughs"] = number(snaps.get("count"))
+    out["ringing_left_out_share"] = number(snaps.get("left_out_share"))
     out["kinetic_energy_check"] = bool((qs.get("energy") or {}).get("holds", False))
     out["came_to_rest"] = bool((summary.get("at_rest") or {}).get("came_to_rest", False))
     end = summary.get("end") or {}
-    out["ended_by"] = str(summary.get("ended_by", ""))  # tip_past_end, far_end, length_used, wall_stretch or jam
+    out["ended_by"] = str(summary.get("ended_by", ""))  # colonsim.insertion.case.run_summary.ENDINGS
     for name, key in (("end_depth_cm", "depth_cm"), ("end_push_force_N", "push_force_N"),
                       ("end_contact_force_N", "contact_force_N")):
         out[name] = number(end.get(key))
