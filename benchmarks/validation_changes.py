@@ -94,9 +94,10 @@ def _verdicts(previous, current):
 
     old, new = pairs(previous), pairs(current)
     flips = [{"check": k[0], "run": f"{k[1].upper()} {k[2]} {k[3]}", "quantity": k[4],
-              "before": old[k]["change"], "after": new[k]["change"],
-              "verdict": f"{'pass' if old[k]['passed'] else 'FAIL'} -> {'pass' if new[k]['passed'] else 'FAIL'}"}
-             for k in new if k in old and old[k].get("passed") != new[k].get("passed")]
+              "before": old[k]["change"] if k in old else None, "after": new[k]["change"],
+              "verdict": f"{_word(old.get(k, {}).get('passed'))} -> {_word(new[k].get('passed'))}",
+              "rule": _rule(old.get(k), new[k], k[4])}
+             for k in new if (old.get(k) or {}).get("passed") != new[k].get("passed")]
 
     def count(d):
         """(passed, compared) per check; a quantity below its floor has no verdict and is not compared."""
@@ -107,6 +108,21 @@ def _verdicts(previous, current):
         return counts
 
     return flips, count(old), count(new)
+
+
+def _word(passed):
+    return "not judged" if passed is None else "pass" if passed else "FAIL"
+
+
+def _rule(old, new, quantity):
+    """Which rule of docs/quasi_static.md changed a pair's verdict, or that its numbers moved."""
+    if new.get("why"):
+        return new["why"]
+    if old is None:
+        return ("judged since the rules of 2026-12-07: the largest lag" if quantity == "lag" else
+                "judged since the rules of 2026-12-07: the count of snap-throughs at half the speed"
+                if quantity == "snap-throughs" else "judged now")
+    return "its numbers moved"
 
 
 def section_at(doc, *path):
@@ -156,7 +172,13 @@ def _summaries(previous, current):
         old = {r["output"]: r for r in section_at(previous, "smoothness", part, "rows") or []}
         for r in section_at(current, "smoothness", part, "rows") or []:
             if r["output"] in old:
-                rows.append({"what": f"{label}: {r['output']}", "before": old[r["output"]].get(key), "after": r.get(key)})
+                o = old[r["output"]]
+                rule = ("" if o.get("passed") == r.get("passed") else
+                        f"verdict {_word(o.get('passed'))} -> {_word(r.get('passed'))}: bound now the larger of "
+                        + ("2 % of the range and 2 x" if part == "cubic" else "5 % of the spread and 1.25 x")
+                        + " the replicates' scatter")
+                rows.append({"what": f"{label}: {r['output']}" + (f" ({rule})" if rule else ""),
+                             "before": o.get(key), "after": r.get(key)})
     return rows
 
 
@@ -222,7 +244,8 @@ def markdown(section) -> list:
     if section["flips"]:
         lines += [md_table(section["flips"], [("check", "check"), ("run", "run"), ("quantity", "quantity"),
                                               ("change before", lambda r: percent(r["before"], "+.1f")),
-                                              ("change now", lambda r: percent(r["after"], "+.1f")), ("verdict", "verdict")]), ""]
+                                              ("change now", lambda r: percent(r["after"], "+.1f")), ("verdict", "verdict"),
+                                              ("what changed it", lambda r: r.get("rule") or "-")]), ""]
     if section.get("claim_flips"):
         lines += ["The source's claims (main sweep, section 4) whose verdict changed:", "",
                   md_table(section["claim_flips"], [("claim", "claim"), ("before", "before"), ("now", "after")]), ""]

@@ -39,7 +39,7 @@ from colonsim.files import write_json
 from colonsim.provenance import code_version
 from colonsim.insertion.case.insertion_case import InsertionCase
 from colonsim.insertion.study.sweep_presets import HALF_SPEED
-from colonsim.insertion.case.outcomes import RINGING_LIMIT
+from colonsim.insertion.case.ringing import RINGING_LIMIT
 from colonsim.insertion.study.claims import evaluate_claims
 
 import validation_carry
@@ -200,6 +200,8 @@ def main(argv=None):
                        ("gp-train", "the surrogate's training sweep (benchmarks/sweeps/gp_train.toml)"),
                        ("gp-test", "the surrogate's held-out sweep (benchmarks/sweeps/gp_test.toml)"),
                        ("rate-angles", "the rate check at the other angles (benchmarks/sweeps/rate_angles.toml)"),
+                       ("replicates", "the replicates that measure the runs' own scatter "
+                                      "(benchmarks/sweeps/gp_replicates.toml)"),
                        ("resistance", "the distal resistance sweep (colonsim sweep --preset resistance)"),
                        ("ringing-half", "the resistance runs above the ringing limit at half the push speed "
                                         "(benchmarks/sweeps/ringing_half_speed.toml)")):
@@ -223,11 +225,12 @@ def main(argv=None):
                                 "give it with --previous OLD/report.json")
         main_sweep = read_sweep("main", args.sweep)
         validation = read_sweep("validation", args.validation_sweep, preset="validation")
-        smooth, gp_train, gp_test, resisted, angles, ringing_half = (
+        smooth, gp_train, gp_test, resisted, angles, ringing_half, replicates = (
             read_sweep(label, folder, optional=True) for label, folder in (
                 ("smoothness", args.smoothness_sweep), ("gp_train", args.gp_train_sweep),
                 ("gp_test", args.gp_test_sweep), ("resistance", args.resistance_sweep),
-                ("rate_angles", args.rate_angles_sweep), ("ringing_half", args.ringing_half_sweep)))
+                ("rate_angles", args.rate_angles_sweep), ("ringing_half", args.ringing_half_sweep),
+                ("replicates", args.replicates_sweep)))
         previous = None if args.previous is None else read_previous(args.previous)
     except ColonsimError as exc:
         print(f"error: {exc}", file=sys.stderr)
@@ -254,7 +257,8 @@ def main(argv=None):
     figs["rsj_deformation"] = {"file": "figures/rsj_deformation.png"}
     sensitivity = flexure_section(validation, main_sweep, out)
     described = {"main": main_sweep, "validation": validation, "smoothness": smooth, "gp_train": gp_train,
-                 "gp_test": gp_test, "resistance": resisted, "rate_angles": angles, "ringing_half": ringing_half}
+                 "gp_test": gp_test, "resistance": resisted, "rate_angles": angles, "ringing_half": ringing_half,
+                 "replicates": replicates}
     flexure_source = "section 10"
     if args.carry and args.validation_sweep is None:  # the claims' readings cite the flexure turns (section 10)
         carried = validation_carry.carried_section(previous, "validation", ("flexure_sensitivity",))
@@ -272,7 +276,7 @@ def main(argv=None):
            "mesh_pair": pair_section(validation, main_sweep, "mesh"),
            "rate_check": rate_section(validation, main_sweep, angles),
            "smoothness": smoothness.section(smooth, gp_train, gp_test, out / "figures" / "smoothness.png",
-                                            "figures/smoothness.png"),
+                                            "figures/smoothness.png", replicates),
            "flexure_sensitivity": sensitivity,
            "resistance": resistance_section(resisted, ringing_half, out),
            "node_counts": sections.node_counts(),

@@ -24,7 +24,7 @@ import math
 import numpy as np
 
 from colonsim.insertion.case.insertion_case import InsertionCase
-from colonsim.insertion.case.outcomes import RINGING_LIMIT, ringing_at_drops, ringing_wavelength
+from colonsim.insertion.case.ringing import RINGING_LIMIT, ringing_at_drops, ringing_wavelength
 from colonsim.insertion.study.claims import evaluate_claims
 from colonsim.insertion.study.sweep_presets import HALF_SPEED
 from colonsim.markdown import NOT_RUN, md_table, num
@@ -82,7 +82,8 @@ def resistance_section(sweep, half=None) -> dict:
                          "final_deformation_cm", "max_deformation_cm", "max_lag_cm", "final_lag_cm",
                          "peak_contact_force_N", "peak_push_force_N", "point_A_cm", "point_B_cm", "point_C_cm",
                          "ringing_ratio", "tip_turned_back_cm")},
-                     "ended_by": str(row.get("ended_by", ""))})
+                     "ended_by": str(row.get("ended_by", "")), "quasi_static": bool(row.get("quasi_static")),
+                     "ringing_cause": str(row.get("ringing_cause") or "")})
     claims = claims_per_level(sweep, speed)
     return {"ran": True, "rows": rows, "missing": missing, "differences": _differences(rows),
             "rsj": [r for r in rows if r["segment"] == "rsj"], "rate": _rate_pairs(sweep, speed),
@@ -129,10 +130,15 @@ def _differences(rows) -> list:
 
 
 def _quasi_static(rows) -> dict:
+    """The ringing verdicts of the rows (docs/quasi_static.md): ``below`` counts the quasi-static runs
+    (the ratio over max(mean, 1 N) below the limit, snap-throughs left out), ``above`` names the rest
+    with their cause."""
     ratios = [r["ringing_ratio"] for r in rows if r["ringing_ratio"] is not None]
     above = [f"{r['segment'].upper()} {r['scope']} {r['where']} {r['level_N']:g} N: {num(r['ringing_ratio'])}"
-             for r in rows if r["ringing_ratio"] is not None and r["ringing_ratio"] >= RINGING_LIMIT]
-    return {"runs": len(rows), "measured": len(ratios), "below": sum(x < RINGING_LIMIT for x in ratios),
+             + (f" ({r['ringing_cause']})" if r.get("ringing_cause") else "")
+             for r in rows if r["ringing_ratio"] is not None and not r["quasi_static"]]
+    return {"runs": len(rows), "measured": len(ratios), "below": sum(bool(r["quasi_static"]) for r in rows
+                                                                     if r["ringing_ratio"] is not None),
             "largest": max(ratios) if ratios else None, "above": above}
 
 
@@ -157,7 +163,7 @@ def ringing_remainder(sweep, speed, half=None) -> dict:
     above, rms_below = [], []
     for case, row, ratio in measured_ringing(sweep, speed):
         qs = sweep.summary(row).get("quasi_static") or {}
-        if ratio < RINGING_LIMIT:
+        if bool(row.get("quasi_static")):
             if qs.get("push_force_rms_N") is not None:
                 rms_below.append(qs["push_force_rms_N"])
             continue
@@ -199,7 +205,7 @@ def rate_changes(base, variant, segment) -> dict:
     """The rate pair of the run ``base`` of ``segment`` and its half-speed run ``variant``, judged as
     the main sweep's pairs are (:func:`validation_sections.pair_quantities`): ``changes``, column ->
     relative change (None below the quantity's floor), tolerance and verdict; and ``passed``."""
-    quantities, passed = pair_quantities(base, variant, segment)
+    quantities, passed = pair_quantities(base, variant, segment, "rate")
     return {"changes": {q["column"]: {"change": None if not np.isfinite(q["change"]) else q["change"],
                                       "limit": q["tolerance"], "passed": q["passed"]} for q in quantities},
             "passed": passed}

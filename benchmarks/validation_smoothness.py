@@ -1,18 +1,22 @@
-"""Smooth across inputs (docs/model.md, "Time integration and damping"): the validation report's
+"""Smooth across inputs (docs/quasi_static.md, "Smooth across inputs"): the validation report's
 section on how smoothly the insertion's outputs follow its inputs.
 
-Two checks, each reading sweeps made with the project's own tools:
+Two checks, each reading sweeps made with the project's own tools, each judged against the larger
+of a share of the output's spread and a multiple of the runs' own scatter (the standard deviation
+over replicate runs that differ by a 7 % finer wall mesh, ``benchmarks/sweeps/gp_replicates.toml``
+against the first ten runs of ``gp_train.toml``; reported per output):
 
 - **against scope diameter**: RSJ D36 mu 0 at scope diameters 9.0 to 13.5 mm in 0.5 mm steps
   (``benchmarks/sweeps/smoothness.toml``); each output's departure from the least-squares cubic
-  in the diameter, largest over the runs, as a share of the output's range. Pass under 2 %. The
+  in the diameter, largest over the runs, as a share of the output's range. Pass under
+  max(2 % of the range, 2 x the scatter). The
   largest deformation is also judged against the larger of the cubics of A and C, which it is
   the larger of (:func:`larger_of_cubics`): a crease where one overtakes the other is a regime
   change no single cubic follows, shown, not smoothed.
 - **a surrogate's held-out error**: the project's GP surrogate fitted on a 20-run Latin hypercube
   of RSJ (scope 9-13.5 mm, D 20-40 mm, mu 0-0.1; ``gp_train.toml``) predicts 30 independent runs
   in the same ranges (``gp_test.toml``); its RMSE as a share of the held-out output's standard
-  deviation. Pass under 5 %.
+  deviation. Pass under max(5 % of that deviation, 1.25 x the scatter).
 """
 
 from __future__ import annotations
@@ -26,8 +30,12 @@ from colonsim.files import save_figure
 from colonsim.insertion.study.claims import NO_DEFORMATION_CM
 from colonsim.insertion.anatomy.scopes import colonoscope
 
-CUBIC_TOLERANCE = 0.02  # of the output's range
-SURROGATE_TOLERANCE = 0.05  # of the held-out output's spread
+CUBIC_TOLERANCE = 0.02  # of the output's range ...
+CUBIC_SCATTER_FACTOR = 2.0  # ... or this many times the runs' own scatter, whichever is larger
+SURROGATE_TOLERANCE = 0.05  # of the held-out output's spread ...
+SURROGATE_SCATTER_FACTOR = 1.25  # ... or this many times the runs' own scatter, whichever is larger
+# a replicate pairs with the run of the same inputs (rounded to this many decimals)
+REPLICATE_INPUTS = ("scope_diameter_mm", "diameter_mm", "friction")
 CUBIC_OUTPUTS = (("final_deformation_cm", "final [cm]"), ("max_deformation_cm", "max [cm]"),
                  ("point_C_cm", "C [cm]"), ("point_A_cm", "A [cm]"))
 SURROGATE_OUTPUTS = ("final_deformation_cm", "max_deformation_cm", "point_A_cm", "point_C_cm", "peak_contact_force_N",
@@ -38,15 +46,42 @@ def _ok(table):
     return table[table["status"] == "ok"] if "status" in table else table
 
 
-def section(smooth, train, test, figure_path, figure_link):
+def section(smooth, train, test, figure_path, figure_link, replicates=None):
     """The report's smoothness section: the departures from a cubic of the ``smooth`` sweep (figure
     written to ``figure_path``, cited as ``figure_link``) and the surrogate fitted on ``train``
-    predicting ``test``."""
-    return {"cubic": cubic_departures(smooth, figure_path), "figure": figure_link,
-            "surrogate": surrogate_holdout(train, test)}
+    predicting ``test``, each judged against the larger of its share and of a multiple of the runs'
+    own scatter (:func:`replicate_scatter` of ``replicates`` against ``train``)."""
+    scatter = replicate_scatter(train, replicates)
+    return {"cubic": cubic_departures(smooth, figure_path, scatter), "figure": figure_link,
+            "surrogate": surrogate_holdout(train, test, scatter), "scatter": scatter}
 
 
-def cubic_departures(sweep, figure_path):
+def replicate_scatter(train, replicates) -> dict:
+    """The runs' own scatter of each output (docs/quasi_static.md, "Smooth across inputs"): its
+    standard deviation over pairs of runs that differ only by a negligible perturbation (a
+    ``replicates`` run and the ``train`` run of the same inputs, :data:`REPLICATE_INPUTS`),
+    sqrt(mean(difference^2) / 2), cm or N, with the number of pairs; {} without replicates."""
+    if replicates is None or not (replicates.ran and train.ran):
+        return {}
+    a, b = _ok(train.table).copy(), _ok(replicates.table).copy()
+    on = [f"_{c}" for c in REPLICATE_INPUTS]
+    for t in (a, b):
+        for c in REPLICATE_INPUTS:
+            t[f"_{c}"] = t[c].astype(float).round(3)
+    pairs = a.merge(b, on=on, suffixes=("", "_replicate"))
+    out = {}
+    for column in {*SURROGATE_OUTPUTS, *(c for c, _ in CUBIC_OUTPUTS)}:
+        d = (pairs[column].astype(float) - pairs[f"{column}_replicate"].astype(float)).to_numpy()
+        d = d[np.isfinite(d)]
+        out[column] = {"scatter": float(np.sqrt(np.mean(d**2) / 2)) if d.size else math.nan, "pairs": int(d.size)}
+    return out
+
+
+def _scatter(scatter, column):
+    return (scatter.get(column) or {}).get("scatter", math.nan)
+
+
+def cubic_departures(sweep, figure_path, scatter=None):
     """Each output's largest departure from its cubic fit in the scope diameter, over its range."""
     if not sweep.ran:
         return {"ran": False}
@@ -62,11 +97,12 @@ def cubic_departures(sweep, figure_path):
             rows.append(_too_few_row(label, column, keep))
             continue
         coef, residual = cubic_fit(d[keep], y[keep])
-        rows.append(_departure_row(label, column, d[keep], y[keep], residual))
+        rows.append(_departure_row(label, column, d[keep], y[keep], residual, scatter))
         curves.append((label, d[keep], y[keep], coef))
-    rows.append(_crease_row(runs, order, d))
+    rows.append(_crease_row(runs, order, d, scatter))
     _cubic_figure(curves, figure_path)
-    return {"ran": True, "rows": rows, "tolerance": CUBIC_TOLERANCE, "scatter_alone": scatter_alone_band(d)}
+    return {"ran": True, "rows": rows, "tolerance": CUBIC_TOLERANCE, "scatter_factor": CUBIC_SCATTER_FACTOR,
+            "scatter_alone": scatter_alone_band(d)}
 
 
 CREASE_LABEL = "max [cm], against the larger of the cubics of A and C"
@@ -82,7 +118,7 @@ def larger_of_cubics(d, a, c):
     return np.maximum(*fits)
 
 
-def _crease_row(runs, order, d):
+def _crease_row(runs, order, d, scatter=None):
     """The largest deformation's departure from :func:`larger_of_cubics` of A and C, as a row of
     :func:`cubic_departures`."""
     a, c, y = (runs[k].to_numpy(dtype=float)[order] for k in ("point_A_cm", "point_C_cm", "max_deformation_cm"))
@@ -90,7 +126,7 @@ def _crease_row(runs, order, d):
     keep = np.isfinite(y) & np.isfinite(fit)
     if keep.sum() < 5:
         return _too_few_row(CREASE_LABEL, "max_deformation_cm", keep)
-    return _departure_row(CREASE_LABEL, "max_deformation_cm", d[keep], y[keep], y[keep] - fit[keep])
+    return _departure_row(CREASE_LABEL, "max_deformation_cm", d[keep], y[keep], y[keep] - fit[keep], scatter)
 
 
 def _too_few_row(label, column, keep):
@@ -98,20 +134,25 @@ def _too_few_row(label, column, keep):
     return {"output": label, "column": column, "runs": int(keep.sum()), "departure": math.nan, "passed": None}
 
 
-def _departure_row(label, column, d, y, residual):
+def _departure_row(label, column, d, y, residual, scatter=None):
     """A row of :func:`cubic_departures`: the largest departure ``residual`` of the output ``y``
     (finite values, at scope diameters ``d``, mm) from its smooth fit, over ``y``'s range, and the
-    verdict against :data:`CUBIC_TOLERANCE`."""
+    verdict against the larger of :data:`CUBIC_TOLERANCE` of the range and
+    :data:`CUBIC_SCATTER_FACTOR` times the runs' own scatter (where measured)."""
     spread = float(np.ptp(y))
     # an output that stays below 0.1 cm everywhere has no range to judge against (nothing
     # measurable, as in the claims: insertion/study/claims.py NO_DEFORMATION_CM)
     judged = float(np.abs(y).max()) >= NO_DEFORMATION_CM and spread > 0
     departure_cm = float(np.max(np.abs(residual)))
     departure = departure_cm / spread if judged else math.nan
+    noise = _scatter(scatter or {}, column)
+    bound = max(CUBIC_TOLERANCE * spread, CUBIC_SCATTER_FACTOR * noise if np.isfinite(noise) else 0.0)
     return {"output": label, "column": column, "runs": int(y.size), "range": spread,
             "departure": departure, "departure_cm": departure_cm if judged else math.nan,
             "at_scope_mm": float(d[np.argmax(np.abs(residual))]) if judged else None,
-            "passed": bool(departure < CUBIC_TOLERANCE) if judged else None}
+            "replicate_scatter": noise, "scatter_share": noise / spread if judged else math.nan,
+            "bound": bound if judged else math.nan,
+            "passed": bool(departure_cm < bound) if judged else None}
 
 
 def cubic_fit(d, y):
@@ -153,7 +194,7 @@ def scatter_of(gp):
     return max(p.noise_std for p in parts) if parts else gp.noise_std
 
 
-def surrogate_holdout(train, test):
+def surrogate_holdout(train, test, replicates=None):
     """The project's surrogate fitted on ``train`` predicting ``test``: RMSE over the held-out
     spread, and the calibration of its 95 % intervals, per output.
 
@@ -190,8 +231,16 @@ def surrogate_holdout(train, test):
         scatter = float(scatter_of(pooled.models_["rsj"][target]))
         rows.append({"output": target, "train_runs": int(train_runs[target].notna().sum()), "test_runs": int(keep.sum()),
                      "rmse": rmse, "spread": spread, "share": share, "coverage95": covered,
-                     "passed": bool(share < SURROGATE_TOLERANCE) if np.isfinite(share) else None,
+                     **_surrogate_verdict(rmse, spread, _scatter(replicates or {}, target)),
                      "pooled_runs": int(pooled_runs[target].notna().sum()),
                      "pooled_loo_share": pooled.cv_["rsj"][target]["rmse"] / pooled_spread if pooled_spread > 0 else math.nan,
                      "scatter": scatter, "scatter_share": scatter / pooled_spread if pooled_spread > 0 else math.nan})
-    return {"ran": True, "rows": rows, "tolerance": SURROGATE_TOLERANCE}
+    return {"ran": True, "rows": rows, "tolerance": SURROGATE_TOLERANCE, "scatter_factor": SURROGATE_SCATTER_FACTOR}
+
+
+def _surrogate_verdict(rmse, spread, noise) -> dict:
+    """The held-out RMSE judged against the larger of :data:`SURROGATE_TOLERANCE` of the held-out
+    spread and :data:`SURROGATE_SCATTER_FACTOR` times the runs' own scatter (where measured)."""
+    bound = max(SURROGATE_TOLERANCE * spread, SURROGATE_SCATTER_FACTOR * noise if np.isfinite(noise) else 0.0)
+    return {"replicate_scatter": noise, "replicate_scatter_share": noise / spread if spread > 0 else math.nan,
+            "bound": bound, "passed": bool(rmse < bound) if spread > 0 and np.isfinite(rmse) else None}

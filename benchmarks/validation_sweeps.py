@@ -21,7 +21,9 @@ import pandas as pd
 from colonsim.catalog import scope_role
 from colonsim.errors import ColonsimError
 from colonsim.insertion.case.results import RUN_SUMMARY
+from colonsim.insertion.case.insertion_case import ABSENT_AT
 from colonsim.insertion.case.scenario import InsertionCase
+from colonsim.insertion.study.run_rules import RULES, apply_current_rules
 from colonsim.insertion.study.sweep import TABLE, read_results
 from colonsim.insertion.study.sweep_spec import load_sweep, parse_sweep
 
@@ -78,16 +80,24 @@ class Sweep:
 
     def describe(self) -> dict:
         ok = int((self.table["status"] == "ok").sum()) if len(self.table) else 0
+        estimates = {}
+        for case in self.cases:
+            if case.key() in self._rows:
+                estimates[case.time_step_estimate] = estimates.get(case.time_step_estimate, 0) + 1
+        rules = self.table[RULES].value_counts().to_dict() if RULES in self.table else {}
         return {"label": self.label, "folder": None if self.folder is None else str(self.folder), "ran": self.ran,
                 "defined": len(self.cases), "in_table": int(len(self.table)), "ok": ok,
-                "failed": int(len(self.table) - ok), "code": self.commits()}
+                "failed": int(len(self.table) - ok), "code": self.commits(), "time_step_estimate": estimates,
+                "rules": {str(k): int(v) for k, v in rules.items() if k}}
 
 
 def _row_case(row) -> InsertionCase:
     """The case of a table row (its input columns)."""
     values = {}
     for f in dataclasses.fields(InsertionCase):
-        if f.name not in row.index:  # a table of older code: the field did not exist, its default ran
+        if f.name not in row.index:  # a table of older code: the field did not exist, the value of before ran
+            if f.name in ABSENT_AT:
+                values[f.name] = ABSENT_AT[f.name]
             continue
         v = row[f.name]
         if f.default is None:  # optional inputs: "" in the table means absent; dicts are JSON text
@@ -123,10 +133,21 @@ def read_sweep(label, folder, preset=None, optional=False) -> Sweep:
                                 origin=str(spec)).cases
         except (KeyError, ValueError) as exc:
             raise ColonsimError(f"{spec} is not a sweep record ({exc}); move it away to read the table alone") from None
+        cases = [recorded_case(c, set(table["key"])) for c in cases]
         table = table[table["key"].isin({c.key() for c in cases})].reset_index(drop=True)
     else:  # a table without its record: the runs in it are the sweep
         cases = [_row_case(row) for _, row in table.iterrows()]
-    return Sweep(label, folder, cases, table, True)
+    return Sweep(label, folder, cases, apply_current_rules(table, folder), True)
+
+
+def recorded_case(case, keys):
+    """``case``, or the same case at the time-step estimate of before 2026-12-07 ("bounds") where
+    only that one is in the table: a record of before is read at the engine that made it (the
+    report names it per sweep), not taken for missing."""
+    if case.key() in keys or case.time_step_estimate == ABSENT_AT["time_step_estimate"]:
+        return case
+    before = dataclasses.replace(case, time_step_estimate=ABSENT_AT["time_step_estimate"])
+    return before if before.key() in keys else case
 
 
 def role(case) -> str | None:
