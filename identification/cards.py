@@ -21,17 +21,20 @@ from __future__ import annotations
 
 import math
 import re
+import warnings
 from pathlib import Path
 
 import numpy as np
 
-from colonsim.errors import ColonsimError
+from colonsim.errors import ColonsimError, ColonsimWarning
 from colonsim.files import atomic_paths
 from colonsim.identification.card_conventions import CARD_TITLE, FORMATS, SUFFIX, check_formats, keyword
 from colonsim.identification.card_options import CardOptions
 from colonsim.identification.card_writers import WRITERS
 from colonsim.identification.hyperelastic import CALIBRATION_LAWS, calibration_law
 from colonsim.insertion.engine.material import read_material_document
+
+LSDYNA_MIN_POISSON = 0.49  # *MAT_077's manual: smaller values may not work
 
 __all__ = ["FORMATS", "SUFFIX", "CardOptions", "card_text", "check_formats", "write_cards", "read_material",
            "card_material", "folder_card_formats"]
@@ -61,7 +64,12 @@ def card_text(fmt, law_name, parameters, options: CardOptions | None = None) -> 
         raise ColonsimError(f"{law.name} takes {len(law.parameter_names)} parameters ({', '.join(law.parameter_names)}), "
                             f"got {p.size}")
     check_parameters(law, p)
-    return WRITERS[fmt](law, p, options or CardOptions())
+    options = options or CardOptions()
+    if fmt == "lsdyna" and options.poisson < LSDYNA_MIN_POISSON:
+        warnings.warn(ColonsimWarning(
+            f"LS-DYNA's manual recommends PR >= {LSDYNA_MIN_POISSON} for its rubber materials; the card's PR is "
+            f"{options.poisson:.4f} (K/mu0 {options.bulk_ratio:g}); choose K/mu0 >= 50 unless you have checked it"))
+    return WRITERS[fmt](law, p, options)
 
 
 def card_path(out_dir, fmt) -> Path:

@@ -95,6 +95,24 @@ def test_every_card_round_trips_through_its_format_convention(fmt, law):
     assert form["density"] == pytest.approx(1180.0, rel=1e-12) and form["material_id"] == 42
 
 
+@pytest.mark.filterwarnings("ignore::colonsim.errors.ColonsimWarning")  # K/mu0 = 20: PR below 0.49
+def test_lsdyna_precision_on_the_fits_as_docs_cards_states():
+    """docs/cards.md: the Treloar fits' LS-DYNA cards give colonsim's stress to 1e-5 at worst
+    (stretch 1-6, three modes) and K to 7e-6; the colon wall's card states its explicit step."""
+    stretch = np.linspace(1.01, 6.0, 200)
+    worst_stress = worst_k = 0.0
+    for law, p in PARAMETERS.items():
+        for ratio in (20.0, 1000.0, 1e5):
+            form = read_card("lsdyna", card_text("lsdyna", law, p, CardOptions(bulk_ratio=ratio)))
+            ours = calibration_law(law)
+            worst_stress = max(worst_stress, *(np.max(np.abs(nominal_stress(form, m, stretch) /
+                                                             ours.nominal_stress(m, stretch, p) - 1)) for m in MODES))
+            worst_k = max(worst_k, abs(form["bulk_modulus"] / (ratio * ours.initial_shear_modulus(p)) - 1))
+    assert 1e-6 < worst_stress <= 1.1e-5 and 1e-6 < worst_k <= 7.5e-6
+    wall = card_text("lsdyna", "mooney_rivlin_3", PARAMETERS["mooney_rivlin_3"]).replace("\n$   ", " ")
+    assert "dilatational wave speed 289.4 m/s, stable step about 3.46 us per mm" in wall
+
+
 def test_the_round_trip_check_can_fail():
     # Abaqus's Ogden mu is mu_p alpha_p / 2: a card written with colonsim's mu_p would be off
     text = card_text("abaqus", "ogden_1", PARAMETERS["ogden_1"]).replace("0.23137593220499747", "0.180799030589")
@@ -220,6 +238,7 @@ def laws_and_parameters(draw):
     return law, _moduli(draw, law), draw(st.sampled_from(FORMATS))
 
 
+@pytest.mark.filterwarnings("ignore::colonsim.errors.ColonsimWarning")  # LS-DYNA's PR below 0.49
 @settings(max_examples=150, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(laws_and_parameters(), st.floats(10.0, 1e5), st.booleans())
 def test_random_parameters_give_cards_that_hold_or_one_line(case, ratio, deck):

@@ -173,3 +173,17 @@ def test_unknown_formats():
         card_text("nastran", "yeoh", YEOH)
     with pytest.raises(ColonsimError, match="unknown card format 'nastran'"):
         read_card("nastran", "")
+
+
+def test_lsdyna_warns_below_its_recommended_poisson_ratio():
+    from colonsim.errors import ColonsimWarning
+    from colonsim.identification.card_options import CardOptions
+
+    with pytest.warns(ColonsimWarning, match=r"recommends PR >= 0.49 .* PR is 0.4754 \(K/mu0 20\)"):
+        card_text("lsdyna", "yeoh", YEOH, CardOptions(bulk_ratio=20.0))
+    import warnings
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        card_text("lsdyna", "yeoh", YEOH, CardOptions(bulk_ratio=50.0))
+        card_text("abaqus", "yeoh", YEOH, CardOptions(bulk_ratio=20.0))
