@@ -4,9 +4,8 @@ parser, and ``colonsim material export`` for an existing material.json."""
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import argparse
+from pathlib import Path
 
 from colonsim.identification.card_options import (BULK_RATIO_DEFAULT, BULK_RATIO_RANGE, DENSITY_DEFAULT, DENSITY_RANGE,
                                                   MATERIAL_ID_RANGE, check_bulk_ratio, check_density, check_material_id,
@@ -34,9 +33,10 @@ def add_calibrate_options(parser):
                         "displacement in mm; default: a slack region found is corrected and said so, a preload only reported")
     c.add_argument("--decimate", type=int, default=None, metavar="N",
                    help="resample every curve at N evenly spaced displacements (stretches) before fitting")
-    parser.add_argument("--export", nargs="+", choices=FORMATS, metavar="FORMAT",
-                        help=f"also write the fitted law as material cards: {', '.join(FORMATS)} (material_<format>.* in --out)")
-    add_card_options(parser.add_argument_group("material cards (with --export)"), given_only=True)
+    cards = parser.add_argument_group("material cards (docs/cards.md; the options below go with --export)")
+    cards.add_argument("--export", nargs="+", choices=FORMATS, metavar="FORMAT",
+                       help=f"also write the fitted law as material cards: {', '.join(FORMATS)} (material_<format>.* in --out)")
+    add_card_options(cards, given_only=True)
 
 
 def _typed(check, convert=float):
@@ -46,7 +46,8 @@ def _typed(check, convert=float):
         try:
             return check(convert(text))
         except ValueError as exc:  # ColonsimError is one
-            message = str(exc) if isinstance(exc, ColonsimError) else f"{text!r} is not a number"
+            kind = "a whole number" if convert is int else "a number"
+            message = str(exc) if isinstance(exc, ColonsimError) else f"{text!r} is not {kind}"
             raise argparse.ArgumentTypeError(message) from None
 
     value_type.__name__ = "number"

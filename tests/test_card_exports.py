@@ -61,7 +61,7 @@ def test_the_default_bulk_modulus_is_stated_on_the_card():
     ("--density", "1e6", "outside 100-5000"), ("--density", "nan", "must be a positive number"),
     ("--bulk-ratio", "5", "K/mu0 must lie in 10-100000"), ("--poisson", "0.5", "--poisson 0.5: K/mu0 must lie"),
     ("--poisson", "0.3", "--poisson 0.3: K/mu0 must lie"), ("--material-id", "0", "must be a whole number in 1-"),
-    ("--material-id", "1.5", "not a number")])
+    ("--material-id", "1.5", "'1.5' is not a whole number")])
 def test_card_options_out_of_range_are_one_line(tmp_path, capsys, option, value, message):
     material = _material(tmp_path / "m" / "material.json", "yeoh", YEOH)
     out = tmp_path / "out"
