@@ -31,7 +31,8 @@ def header(fmt, law, p, options: CardOptions) -> list[str]:
     chosen = options.bulk_given or "the default; the bulk-ratio or poisson option chooses another"
     wave = math.sqrt((K + 4.0 / 3.0 * mu0) / options.density)
     implicit = (f"implicit solvers need hybrid (mixed u-p) elements above Poisson's ratio {HYBRID_POISSON}"
-                if options.poisson > HYBRID_POISSON else "implicit solvers may use displacement elements")
+                if options.poisson > HYBRID_POISSON else f"below Poisson's ratio {HYBRID_POISSON} implicit solvers "
+                "do not require hybrid elements")
     parts = [f"{CARD_TITLE} ({fmt}): law {law.name}, fitted by colonsim calibrate",
              "units: tonne, mm, s, N, MPa (stress and moduli in MPa, density in tonne/mm^3)",
              f"keyword: {word.name}; convention: {word.energy}",

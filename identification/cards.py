@@ -37,7 +37,7 @@ from colonsim.insertion.engine.material import read_material_document
 LSDYNA_MIN_POISSON = 0.49  # *MAT_077's manual: smaller values may not work
 
 __all__ = ["FORMATS", "SUFFIX", "CardOptions", "card_text", "check_formats", "write_cards", "read_material",
-           "card_material", "folder_card_formats"]
+           "card_material", "card_path", "folder_card_formats"]
 
 
 def check_parameters(law, p):
@@ -59,7 +59,11 @@ def card_text(fmt, law_name, parameters, options: CardOptions | None = None) -> 
     """The card of ``law_name`` with ``parameters`` ({name: value} or sequence; Pa) in ``fmt``."""
     keyword(fmt, law_name)
     law = calibration_law(law_name)
-    p = law.values(parameters)
+    try:
+        p = law.values(parameters)
+    except (KeyError, TypeError, ValueError) as exc:
+        raise ColonsimError(f"{law.name} takes the numbers {', '.join(law.parameter_names)} (Pa); got {parameters!r} "
+                            f"({type(exc).__name__}: {exc})") from None
     if p.size != len(law.parameter_names):
         raise ColonsimError(f"{law.name} takes {len(law.parameter_names)} parameters ({', '.join(law.parameter_names)}), "
                             f"got {p.size}")

@@ -168,6 +168,13 @@ def test_readers_refuse_what_is_not_a_card_in_one_line(fmt, text):
     assert "\n" not in str(err.value)
 
 
+def test_parameters_that_are_not_the_laws_are_one_line():
+    with pytest.raises(ColonsimError, match="yeoh takes the numbers C10, C20, C30"):
+        card_text("abaqus", "yeoh", {"C10": 1e5})
+    with pytest.raises(ColonsimError, match="yeoh takes 3 parameters"):
+        card_text("abaqus", "yeoh", [1e5, 1.0])
+
+
 def test_unknown_formats():
     with pytest.raises(ColonsimError, match="unknown export format 'nastran'"):
         card_text("nastran", "yeoh", YEOH)
