@@ -154,7 +154,7 @@ def _fitted_laws(args):
 def check_export(args):
     """Before a calibration, before anything is fitted or written: refuse --export with
     --per-specimen, a format that cannot hold the law (whichever law the fit will write), card
-    options without --export, and cards in --out that the new fit would leave stale."""
+    options without --export, and cards in --out that the new material.json would leave stale."""
     from colonsim.errors import ColonsimError
     from colonsim.identification.cards import FORMATS as ALL, card_path, check_formats
 
@@ -163,7 +163,7 @@ def check_export(args):
         if given:
             raise ColonsimError(f"{given[0]} sets the material cards; add --export FORMAT, or drop it")
         held = [card_path(args.out, f).name for f in ALL if card_path(args.out, f).is_file()]
-        if held:
+        if held and not args.per_specimen:  # --per-specimen leaves the folder's material.json alone
             raise ColonsimError(f"{args.out} holds material cards of the earlier fit ({', '.join(held)}), which the new "
                                 "material.json would leave stale; add --export with their formats to rewrite them, "
                                 "or choose another --out")

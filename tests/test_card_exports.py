@@ -145,6 +145,20 @@ def test_a_calibration_into_a_folder_with_cards_replaces_them_or_is_refused(tmp_
     assert card_material(out / "material_ansys.mac")[1] == params
 
 
+def test_per_specimen_fits_leave_the_folders_cards_alone(tmp_path):
+    """--per-specimen writes no material.json of its own, so the folder's cards stay right."""
+    import argparse
+
+    from colonsim.cli_material import CARD_OPTIONS, check_export
+
+    _material(tmp_path / "material.json", "yeoh", YEOH)
+    assert main(["material", "export", str(tmp_path / "material.json"), "--format", "abaqus"]) == 0
+    args = argparse.Namespace(export=None, out=tmp_path, law=None, compare_laws=False, **dict.fromkeys(CARD_OPTIONS))
+    check_export(argparse.Namespace(**vars(args), per_specimen=True))
+    with pytest.raises(ColonsimError, match="holds material cards of the earlier fit"):
+        check_export(argparse.Namespace(**vars(args), per_specimen=False))
+
+
 @pytest.mark.parametrize("doc,message", [
     ({"law": "yeoh", "units": "Pa", "parameters": {"C10": float("nan"), "C20": 0.0, "C30": 0.0}}, "parameter C10 is nan"),
     ({"law": "yeoh", "units": "Pa", "parameters": {"C10": -1e5, "C20": 0.0, "C30": 0.0}},
