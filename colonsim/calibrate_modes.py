@@ -130,11 +130,12 @@ def calibrate_modes(request: ModeRequest, out: Path) -> list:
     from colonsim.identification.joint import UnsolvableNearFit, calibrate_joint
     from colonsim.identification.joint_report import write_comparison, write_joint
     from colonsim.identification.search import Budget
+    from colonsim.laws import DEFAULT_LAW
 
     check_output_folder(out)
     if request.compare_laws and request.law is not None:
         raise ColonsimError(f"--compare-laws fits every law; drop --law {request.law}")
-    law = request.law or "mooney_rivlin_3"
+    law = request.law or DEFAULT_LAW
     calibration_law(law)
     if request.stability_range is not None and not (0 < request.stability_range[0] < 1 < request.stability_range[1]):
         lo, hi = request.stability_range

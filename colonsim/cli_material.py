@@ -4,9 +4,13 @@ parser, and ``colonsim material export`` for an existing material.json."""
 
 from __future__ import annotations
 
+import argparse
 from pathlib import Path
 
-from colonsim.identification.cards import DENSITY, FORMATS
+from colonsim.identification.card_options import (BULK_RATIO_DEFAULT, BULK_RATIO_RANGE, DENSITY_DEFAULT, DENSITY_RANGE,
+                                                  MATERIAL_ID_RANGE, check_bulk_ratio, check_density, check_material_id,
+                                                  check_poisson, poisson_from_bulk_ratio)
+from colonsim.identification.cards import FORMATS, SUFFIX
 from colonsim.options import finite_float, output_folder
 
 
@@ -29,8 +33,69 @@ def add_calibrate_options(parser):
                         "displacement in mm; default: a slack region found is corrected and said so, a preload only reported")
     c.add_argument("--decimate", type=int, default=None, metavar="N",
                    help="resample every curve at N evenly spaced displacements (stretches) before fitting")
-    parser.add_argument("--export", nargs="+", choices=FORMATS, metavar="FORMAT",
-                        help=f"also write the fitted law as material cards: {', '.join(FORMATS)} (material_<format>.* in --out)")
+    cards = parser.add_argument_group("material cards (docs/cards.md; the options below go with --export)")
+    cards.add_argument("--export", nargs="+", choices=FORMATS, metavar="FORMAT",
+                       help=f"also write the fitted law as material cards: {', '.join(FORMATS)} (material_<format>.* in --out)")
+    add_card_options(cards, given_only=True)
+
+
+def _typed(check, convert=float):
+    def value_type(text):
+        from colonsim.errors import ColonsimError
+
+        try:
+            return check(convert(text))
+        except ValueError as exc:  # ColonsimError is one
+            kind = "a whole number" if convert is int else "a number"
+            message = str(exc) if isinstance(exc, ColonsimError) else f"{text!r} is not {kind}"
+            raise argparse.ArgumentTypeError(message) from None
+
+    value_type.__name__ = "number"
+    return value_type
+
+
+def add_card_options(group, given_only=False):
+    """The options of the cards: material id, density, bulk modulus, deck or include. With
+    ``given_only`` their defaults are None, so that a value given without --export is noticed."""
+    def default(value):
+        return None if given_only else value
+
+    low, high = BULK_RATIO_RANGE
+    group.add_argument("--material-id", type=_typed(check_material_id, int), default=default(1), metavar="N",
+                       help=f"material number in the cards (LS-DYNA MID, ANSYS material, FEBio id, Abaqus name "
+                            f"COLONSIM_N), {MATERIAL_ID_RANGE[0]}-{MATERIAL_ID_RANGE[1]:,} (default 1)")
+    group.add_argument("--density", type=_typed(check_density), default=default(DENSITY_DEFAULT), metavar="KG_M3",
+                       help=f"density, kg/m^3, {DENSITY_RANGE[0]:g}-{DENSITY_RANGE[1]:g} (default {DENSITY_DEFAULT:g}, "
+                            "the colon wall's; rubber 900-2000)")
+    bulk = group.add_mutually_exclusive_group() if hasattr(group, "add_mutually_exclusive_group") else group
+    bulk.add_argument("--bulk-ratio", type=_typed(check_bulk_ratio), default=None, metavar="K_MU0",
+                      help=f"bulk modulus as K/mu0, {low:g}-{high:g} (default {BULK_RATIO_DEFAULT:g}, Poisson's ratio "
+                           f"{poisson_from_bulk_ratio(BULK_RATIO_DEFAULT):.4f}; docs/cards.md: larger follows the "
+                           "incompressible fit more closely and shortens an explicit solver's stable step)")
+    bulk.add_argument("--poisson", type=_typed(check_poisson), default=None, metavar="NU",
+                      help=f"bulk modulus as the small-strain Poisson's ratio, {poisson_from_bulk_ratio(low):.4f}-"
+                           f"{poisson_from_bulk_ratio(high):.6f} (instead of --bulk-ratio)")
+    group.add_argument("--deck", action="store_true", default=None if given_only else False,
+                       help="write stand-alone files (LS-DYNA *KEYWORD ... *END, ANSYS /PREP7 ... FINISH, FEBio "
+                            "<febio_spec>) instead of include files (default)")
+
+
+CARD_OPTIONS = ("material_id", "density", "bulk_ratio", "poisson", "deck")
+
+
+def card_options(args):
+    """The CardOptions of the parsed options (defaults for those not given)."""
+    from colonsim.identification.card_options import CardOptions
+
+    given = {}
+    if args.bulk_ratio is not None:
+        given = dict(bulk_ratio=args.bulk_ratio, bulk_given=f"bulk-ratio {args.bulk_ratio:g} given")
+    elif args.poisson is not None:  # check_poisson turned it into K/mu0
+        given = dict(bulk_ratio=args.poisson,
+                     bulk_given=f"poisson {poisson_from_bulk_ratio(args.poisson):.6g} given")
+    return CardOptions(material_id=args.material_id or 1,
+                       density=DENSITY_DEFAULT if args.density is None else args.density,
+                       deck=bool(args.deck), **given)
 
 
 def _load_start(text):
@@ -50,61 +115,76 @@ def add_parsers(sub):
     msub = p.add_subparsers(dest="material_command", required=True)
     e = msub.add_parser("export", help="write material.json's law as LS-DYNA, Abaqus, ANSYS or FEBio cards",
                         description="Write the law of a colonsim material.json as material cards (units tonne, mm, s, N, "
-                                    "MPa; bulk modulus 1000 mu0; docs/calibration.md).")
+                                    "MPa; docs/cards.md). Cards already in the output folder that were written from "
+                                    "another material are rewritten with them; a folder whose material.json holds "
+                                    "another material is refused.")
     e.add_argument("material", type=Path, help="material.json written by colonsim calibrate")
     e.add_argument("--format", nargs="+", required=True, choices=FORMATS, help="one or more of " + ", ".join(FORMATS))
     e.add_argument("--out", type=output_folder, default=None, help="output folder (default: the material file's folder)")
-    e.add_argument("--density", type=finite_float, default=DENSITY,
-                   help=f"density written into the cards, kg/m^3 (default {DENSITY:g}, the colon wall's)")
+    add_card_options(e)
     e.set_defaults(func=cmd_material_export)
 
 
-def _law_and_parameters(path):
-    from colonsim.errors import ColonsimError
-    from colonsim.identification.hyperelastic import calibration_law
-    from colonsim.insertion.engine.material import read_material_document
-
-    doc = read_material_document(path)
-    law = doc.get("law")
-    if not isinstance(law, str):
-        raise ColonsimError(f"material file {path} has no law; pass a material.json of colonsim calibrate")
-    names = calibration_law(law).parameter_names
-    params = doc.get("parameters")
-    if not isinstance(params, dict) or any(n not in params for n in names) or doc.get("units", "Pa") != "Pa":
-        raise ColonsimError(f"material file {path} lacks the parameters {', '.join(names)} in Pa; regenerate it")
-    return law, params
+def _written(paths, asked):
+    for path in paths:
+        stale = path.name not in {f"material_{f}.{SUFFIX[f]}" for f in asked}
+        print(f"{path}" + ("  (rewritten: it held another material's card)" if stale else ""))
 
 
 def cmd_material_export(args):
-    from colonsim.identification.cards import write_cards
+    from colonsim.identification.cards import read_material, write_cards
 
-    law, params = _law_and_parameters(args.material)
+    options = card_options(args)
+    law, params = read_material(args.material)
     out = args.out if args.out is not None else args.material.parent
-    for path in write_cards(args.format, law, params, out, args.density):
-        print(f"{path}")
+    _written(write_cards(args.format, law, params, out, options, source=args.material), args.format)
+
+
+def _fitted_laws(args):
+    """The laws a calibration may write: --law, every law with --compare-laws, else the default."""
+    from colonsim.calibrate_modes import wants_modes as modes
+    from colonsim.identification.hyperelastic import CALIBRATION_LAWS
+    from colonsim.laws import DEFAULT_LAW, LAWS
+
+    if args.compare_laws:
+        return list(CALIBRATION_LAWS if modes(args.manifest, args.curve, args.mode) else LAWS)
+    return [args.law or DEFAULT_LAW]
 
 
 def check_export(args):
-    """Before a calibration: refuse --export with --per-specimen, or a format that cannot hold --law."""
+    """Before a calibration, before anything is fitted or written: refuse --export with
+    --per-specimen, a format that cannot hold the law (whichever law the fit will write), card
+    options without --export, and cards in --out that the new material.json would leave stale."""
     from colonsim.errors import ColonsimError
-    from colonsim.identification.cards import check_formats
+    from colonsim.identification.cards import FORMATS as ALL, card_path, check_formats
 
+    given = [f"--{o.replace('_', '-')}" for o in CARD_OPTIONS if getattr(args, o) is not None]
     if not args.export:
+        if given:
+            raise ColonsimError(f"{given[0]} sets the material cards; add --export FORMAT, or drop it")
+        held = [card_path(args.out, f).name for f in ALL if card_path(args.out, f).is_file()]
+        if held and not args.per_specimen:  # --per-specimen leaves the folder's material.json alone
+            raise ColonsimError(f"{args.out} holds material cards of the earlier fit ({', '.join(held)}), which the new "
+                                "material.json would leave stale; add --export with their formats to rewrite them, "
+                                "or choose another --out")
         return
     if args.per_specimen:
         raise ColonsimError("--export writes one material's cards; fit the mean curve, or export a specimen's "
                             "material.json with colonsim material export")
-    if args.law is not None:
-        check_formats(args.export, args.law)
+    held = [f for f in ALL if card_path(args.out, f).is_file()]
+    check_formats(list(dict.fromkeys([*args.export, *held])), _fitted_laws(args))
+    card_options(args)
 
 
 def export_after(args):
-    """After a calibration: the cards of the material.json it wrote."""
-    from colonsim.identification.cards import write_cards
+    """After a calibration: the cards of the material.json it wrote (and the folder's earlier
+    cards, rewritten from it)."""
+    from colonsim.identification.cards import read_material, write_cards
 
     if args.export:
-        law, params = _law_and_parameters(args.out / "material.json")
-        paths = write_cards(args.export, law, params, args.out)
+        material = args.out / "material.json"
+        law, params = read_material(material)
+        paths = write_cards(args.export, law, params, args.out, card_options(args), source=material)
         print("material cards: " + ", ".join(str(p) for p in paths))
 
 

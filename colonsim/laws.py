@@ -246,6 +246,8 @@ LAWS = {
 }
 
 
+DEFAULT_LAW = "mooney_rivlin_3"  # the source's law; what a calibration fits when no law is named
+
 OGDEN_INDEX = 1 + max(law.index for law in LAWS.values())
 OGDEN_LAWS = {f"ogden_{n}": OgdenLaw(f"ogden_{n}", n, OGDEN_INDEX) for n in (1, 2, 3)}
 # every law the insertion shell runs and a material file may name

@@ -185,7 +185,7 @@ def _print_warnings(results):
 def calibrate(request: CalibrationRequest, out: Path) -> list:
     """Load the curves ``request`` names, calibrate, write results into ``out``; return the results."""
     from colonsim.files import check_output_folder, output_set
-    from colonsim.laws import get_law
+    from colonsim.laws import DEFAULT_LAW, get_law
     from colonsim.limits import (POINTS_RANGE, check_count, check_geometry_mm, check_mesh, check_seed,
                                  check_workers)
     from colonsim.identification.pipeline import Budget
@@ -198,7 +198,7 @@ def calibrate(request: CalibrationRequest, out: Path) -> list:
         raise ColonsimError(f"--compare-laws fits every law; drop --law {request.law}")
     if request.compare_laws and request.per_specimen:
         raise ColonsimError("--compare-laws fits one curve (or the mean curve); drop --per-specimen")
-    law = request.law or "mooney_rivlin_3"
+    law = request.law or DEFAULT_LAW
     get_law(law)
     if isinstance(request.points, int) and request.points < POINTS_RANGE[0]:
         raise ColonsimError(f"--points {request.points} is too few to fit 3 parameters; use at least 5 (default 20)")

@@ -1,219 +1,156 @@
 """Material cards of a fitted law for other solvers: LS-DYNA, Abaqus, ANSYS (MAPDL) and FEBio.
 
-Every format writes the same hyperelastic law with its own constants. Each format's documented
-strain-energy convention is written down once, in :data:`CONVENTIONS`; the writers below turn
-colonsim's parameters into it and :mod:`colonsim.identification.card_readers` turns a card back
-into stresses with the same table.
+Every format writes the same hyperelastic law with its own constants:
+:mod:`colonsim.identification.card_conventions` holds each format's keyword and strain-energy
+convention, :mod:`colonsim.identification.card_writers` the text of each card,
+:mod:`colonsim.identification.card_options` the material id, density, bulk modulus and deck or
+include, and :mod:`colonsim.identification.card_readers` reads a card back. This module checks
+what goes into a card and writes a folder's cards as one set.
 
-colonsim's own conventions (:mod:`colonsim.identification.hyperelastic`): the invariant laws
-``W = sum C_ij (I1 - 3)^i (I2 - 3)^j`` (C10, C01, C11, C20, C30 in Pa), Ogden
-``W = sum_p mu_p / alpha_p (l1^alpha_p + l2^alpha_p + l3^alpha_p - 3)``.
+Every card is in the unit system tonne, mm, s, N, MPa and says so in its comment lines, with the
+bulk modulus chosen and colonsim's parameters, from which :func:`card_material` tells which
+material a card was written from.
 
-Every card is in the unit system tonne, mm, s, N, MPa (stresses and moduli in MPa, density in
-tonne/mm^3), stated in its comment lines. The solvers need a bulk term that colonsim's
-incompressible fit does not have: every card takes ``K = 1000 mu0`` (Poisson's ratio 0.4995), a
-common choice for rubber-like solids in explicit and implicit codes alike, and says so. The
-density is the colon wall's 1040 kg/m^3 (docs/model.md) unless given.
+The cards in a folder and its ``material.json`` describe one material. An export into a folder
+whose ``material.json`` holds another material is refused; colonsim cards already in the folder
+that were written from another material are rewritten with the same set (all files replaced
+together, or none).
 """
 
 from __future__ import annotations
 
+import math
+import re
+import warnings
 from pathlib import Path
 
 import numpy as np
 
-from colonsim.errors import ColonsimError
+from colonsim.errors import ColonsimError, ColonsimWarning
 from colonsim.files import atomic_paths
-from colonsim.identification.hyperelastic import calibration_law
+from colonsim.identification.card_conventions import CARD_TITLE, FORMATS, SUFFIX, check_formats, keyword
+from colonsim.identification.card_options import CardOptions
+from colonsim.identification.card_writers import WRITERS
+from colonsim.identification.hyperelastic import CALIBRATION_LAWS, calibration_law
+from colonsim.insertion.engine.material import read_material_document
 
-FORMATS = ("lsdyna", "abaqus", "ansys", "febio")
-SUFFIX = {"lsdyna": "k", "abaqus": "inp", "ansys": "mac", "febio": "xml"}
-BULK_OVER_SHEAR = 1000.0
-DENSITY = 1040.0  # kg/m^3, the colon wall's (docs/model.md)
-MPA = 1e6
+LSDYNA_MIN_POISSON = 0.49  # *MAT_077's manual: smaller values may not work
 
-# The strain-energy convention of each format's hyperelastic material, as its manual writes it
-# (bars: isochoric quantities; the volumetric term vanishes at J = 1). ``ogden`` gives the factor k
-# of k (l1^a + l2^a + l3^a - 3) from the format's two constants of a term (m, a).
-CONVENTIONS = {
-    "lsdyna": {"invariant": "*MAT_HYPERELASTIC_RUBBER (077-H): W = sum C_pq (J1 - 3)^p (J2 - 3)^q + W_H(J)",
-               "ogden": "*MAT_OGDEN_RUBBER (077-O): W = sum_i sum_j mu_j / alpha_j (l_i^alpha_j - 1) + K (J - 1 - ln J)",
-               "ogden_factor": lambda m, a: m / a, "bulk": "PR, Poisson's ratio"},
-    "abaqus": {"invariant": "*HYPERELASTIC, POLYNOMIAL / MOONEY-RIVLIN / NEO HOOKE / YEOH: "
-                            "W = sum C_ij (I1b - 3)^i (I2b - 3)^j + sum 1/D_i (J - 1)^(2i)",
-               "ogden": "*HYPERELASTIC, OGDEN: W = sum 2 mu_i / alpha_i^2 (l1b^alpha_i + l2b^alpha_i + l3b^alpha_i - 3) "
-                        "+ sum 1/D_i (J - 1)^(2i)",
-               "ogden_factor": lambda m, a: 2.0 * m / a**2, "bulk": "D1 = 2 / K"},
-    "ansys": {"invariant": "TB,HYPER MOONEY (2 or 3 parameters) / NEO / YEOH: W = sum c_ij (I1b - 3)^i (I2b - 3)^j "
-                           "+ sum 1/d_k (J - 1)^(2k); NEO: W = mu/2 (I1b - 3) + 1/d (J - 1)^2",
-              "ogden": "TB,HYPER OGDEN: W = sum mu_i / alpha_i (l1b^alpha_i + l2b^alpha_i + l3b^alpha_i - 3) "
-                       "+ sum 1/d_k (J - 1)^(2k)",
-              "ogden_factor": lambda m, a: m / a, "bulk": "d = 2 / K"},
-    "febio": {"invariant": "Mooney-Rivlin (uncoupled): W = c1 (I1t - 3) + c2 (I2t - 3) + k/2 (ln J)^2",
-              "ogden": "Ogden (uncoupled): W = sum c_i / m_i^2 (l1t^m_i + l2t^m_i + l3t^m_i - 3) + k/2 (ln J)^2",
-              "ogden_factor": lambda m, a: m / a**2, "bulk": "k, bulk modulus"},
-}
+__all__ = ["FORMATS", "SUFFIX", "CardOptions", "card_text", "check_formats", "write_cards", "read_material",
+           "card_material", "card_path", "folder_card_formats"]
 
 
-def _g(v) -> str:
-    """A number as the card writes it: shortest repr that reads back to the same float."""
-    return repr(float(v))
-
-
-def _header(fmt, law, params, comment="$"):
-    mu0 = law.initial_shear_modulus(params)
-    K = BULK_OVER_SHEAR * mu0
-    kind = "ogden" if law.terms else "invariant"
-    lines = [f"colonsim material card ({fmt}): law {law.name}, fitted by colonsim calibrate",
-             "units: tonne, mm, s, N, MPa (stress and moduli in MPa, density in tonne/mm^3)",
-             f"convention: {CONVENTIONS[fmt][kind]}",
-             f"near-incompressibility: K = {BULK_OVER_SHEAR:g} mu0 = {_g(K / MPA)} MPa (mu0 = {_g(mu0 / MPA)} MPa, "
-             f"Poisson's ratio {_poisson():.4f}), written as {CONVENTIONS[fmt]['bulk']}; colonsim's fit is incompressible",
-             "colonsim parameters (Pa): " + ", ".join(f"{n}={_g(v)}" for n, v in zip(law.parameter_names, params))]
-    return [f"{comment} {line}" for line in lines], mu0, K
-
-
-def _poisson():
-    r = BULK_OVER_SHEAR
-    return (3 * r - 2) / (2 * (3 * r + 1))
-
-
-def _refuse(fmt, law, what):
-    raise ColonsimError(f"{fmt} cannot hold {law.name}: {what}; export it as "
-                        f"{', '.join(f for f in FORMATS if f != fmt and _expressible(f, law))} instead")
-
-
-def _expressible(fmt, law) -> bool:
-    try:
-        _check(fmt, law)
-        return True
-    except ColonsimError:
-        return False
-
-
-def _check(fmt, law):
-    if fmt == "febio" and law.name in ("mooney_rivlin_3", "yeoh"):
-        raise ColonsimError("FEBio's uncoupled Mooney-Rivlin has no C11 or higher-order I1 term")
-    if law.terms and fmt == "lsdyna" and law.terms > 8:
-        raise ColonsimError("LS-DYNA's Ogden rubber takes up to 8 terms")
-
-
-def lsdyna(law, p, density):
-    lines, mu0, K = _header("lsdyna", law, p)
-    ro = density * 1e-12
-    if law.terms:
-        mus, alphas = p[0::2] / MPA, p[1::2]
-        lines += ["*MAT_OGDEN_RUBBER", "$     MID        RO        PR         N        NV         G      SIGF       REF",
-                  _row([1, ro, _poisson(), 0, 0, 0, 0, 0]), "$ MU1..MU8", _row(list(mus) + [0] * (8 - len(mus))),
-                  "$ ALPHA1..ALPHA8", _row(list(alphas) + [0] * (8 - len(alphas)))]
-    else:
-        c = dict(zip(law.parameter_names, p / MPA))
-        lines += ["*MAT_HYPERELASTIC_RUBBER", "$     MID        RO        PR         N        NV         G      SIGF       REF",
-                  _row([1, ro, _poisson(), 0, 0, 0, 0, 0]), "$ C10 C01 C11 C20 C02 C30 THERML",
-                  _row([c.get("C10", 0.0), c.get("C01", 0.0), c.get("C11", 0.0), c.get("C20", 0.0), 0.0, c.get("C30", 0.0), 0.0])]
-    return "\n".join(lines + ["*END", ""])
-
-
-def _row(values):
-    # LS-DYNA free format: comma-separated fields (full precision, no 10-character limit)
-    return ",".join(_g(v) if isinstance(v, (float, np.floating)) else str(v) for v in values)
-
-
-def abaqus(law, p, density):
-    lines, mu0, K = _header("abaqus", law, p, "**")
-    d1 = 2.0 / (K / MPA)
-    lines += ["*MATERIAL, NAME=COLONSIM", "*DENSITY", _g(density * 1e-12)]
-    c = dict(zip(law.parameter_names, p / MPA))
-    if law.terms:
-        values = [v for i in range(law.terms) for v in (p[2 * i] * p[2 * i + 1] / 2 / MPA, p[2 * i + 1])]
-        values += [d1] + [0.0] * (law.terms - 1)
-        lines += [f"*HYPERELASTIC, OGDEN, N={law.terms}"] + [", ".join(_g(v) for v in values[i:i + 8]) for i in range(0, len(values), 8)]
-    elif law.name == "mooney_rivlin_3":
-        lines += ["*HYPERELASTIC, POLYNOMIAL, N=2", ", ".join(_g(v) for v in (c["C10"], c["C01"], 0.0, c["C11"], 0.0, d1, 0.0))]
-    elif law.name == "mooney_rivlin_2":
-        lines += ["*HYPERELASTIC, MOONEY-RIVLIN", ", ".join(_g(v) for v in (c["C10"], c["C01"], d1))]
-    elif law.name == "neo_hookean":
-        lines += ["*HYPERELASTIC, NEO HOOKE", ", ".join(_g(v) for v in (c["C10"], d1))]
-    else:  # yeoh
-        lines += ["*HYPERELASTIC, YEOH", ", ".join(_g(v) for v in (c["C10"], c["C20"], c["C30"], d1, 0.0, 0.0))]
-    return "\n".join(lines + [""])
-
-
-def ansys(law, p, density):
-    lines, mu0, K = _header("ansys", law, p, "!")
-    d = 2.0 / (K / MPA)
-    c = dict(zip(law.parameter_names, p / MPA))
-    lines += ["MAT,1", f"MP,DENS,1,{_g(density * 1e-12)}"]
-    if law.terms:
-        table, values = f"TB,HYPER,1,,{law.terms},OGDEN", [v for i in range(law.terms) for v in (p[2 * i] / MPA, p[2 * i + 1])]
-        values += [d] + [0.0] * (law.terms - 1)
-    elif law.name == "mooney_rivlin_3":
-        table, values = "TB,HYPER,1,,3,MOONEY", [c["C10"], c["C01"], c["C11"], d]
-    elif law.name == "mooney_rivlin_2":
-        table, values = "TB,HYPER,1,,2,MOONEY", [c["C10"], c["C01"], d]
-    elif law.name == "neo_hookean":
-        table, values = "TB,HYPER,1,,,NEO", [2.0 * c["C10"], d]
-    else:
-        table, values = "TB,HYPER,1,,3,YEOH", [c["C10"], c["C20"], c["C30"], d, 0.0, 0.0]
-    lines.append(table)
-    lines += [f"TBDATA,{i + 1}," + ",".join(_g(v) for v in values[i:i + 6]) for i in range(0, len(values), 6)]
-    return "\n".join(lines + [""])
-
-
-def febio(law, p, density):
-    comments, mu0, K = _header("febio", law, p, "")
-    lines = ["<!--"] + [c.strip() for c in comments] + ["-->", "<Material>"]
-    if law.terms:
-        lines.append('\t<material id="1" name="colonsim" type="Ogden">')
-        lines.append(f"\t\t<density>{_g(density * 1e-12)}</density>")
-        lines.append(f"\t\t<k>{_g(K / MPA)}</k>")
-        for i in range(law.terms):
-            lines.append(f"\t\t<c{i + 1}>{_g(p[2 * i] * p[2 * i + 1] / MPA)}</c{i + 1}>")
-            lines.append(f"\t\t<m{i + 1}>{_g(p[2 * i + 1])}</m{i + 1}>")
-    else:
-        c = dict(zip(law.parameter_names, p / MPA))
-        lines += ['\t<material id="1" name="colonsim" type="Mooney-Rivlin">', f"\t\t<density>{_g(density * 1e-12)}</density>",
-                  f"\t\t<c1>{_g(c['C10'])}</c1>", f"\t\t<c2>{_g(c.get('C01', 0.0))}</c2>", f"\t\t<k>{_g(K / MPA)}</k>"]
-    lines += ["\t</material>", "</Material>", ""]
-    return "\n".join(lines)
-
-
-WRITERS = {"lsdyna": lsdyna, "abaqus": abaqus, "ansys": ansys, "febio": febio}
-
-
-def card_text(fmt, law_name, parameters, density=DENSITY) -> str:
-    """The card of ``law_name`` with ``parameters`` ({name: value} or sequence; Pa) in ``fmt``."""
-    if fmt not in WRITERS:
-        raise ColonsimError(f"unknown export format {fmt!r}; use {', '.join(FORMATS)}")
-    law = calibration_law(law_name)
-    p = law.values(parameters)
-    try:
-        _check(fmt, law)
-    except ColonsimError as exc:
-        _refuse(fmt, law, str(exc))
+def check_parameters(law, p):
+    """Refuse parameters no card should carry: non-finite ones, a zero Ogden exponent, an initial
+    shear modulus that is not positive."""
+    bad = [(n, float(v)) for n, v in zip(law.parameter_names, p) if not math.isfinite(v)]
+    if bad:
+        raise ColonsimError(f"{law.name}: parameter {bad[0][0]} is {bad[0][1]!r}; "
+                            "a card needs finite numbers: refit, or fix material.json")
     if law.terms and np.any(p[1::2] == 0.0):
         raise ColonsimError(f"{law.name}: an Ogden exponent is 0, which no card can hold (mu/alpha); refit")
-    return WRITERS[fmt](law, p, float(density))
+    mu0 = law.initial_shear_modulus(p)
+    if not mu0 > 0:
+        raise ColonsimError(f"{law.name}: initial shear modulus {mu0:.6g} Pa is not positive, so the material is "
+                            "unstable at rest and no solver can use it; refit (fix the data's units or sign)")
 
 
-def check_formats(formats, law_name):
-    """Refuse, before anything is written, a format that cannot hold ``law_name``."""
+def card_text(fmt, law_name, parameters, options: CardOptions | None = None) -> str:
+    """The card of ``law_name`` with ``parameters`` ({name: value} or sequence; Pa) in ``fmt``."""
+    keyword(fmt, law_name)
     law = calibration_law(law_name)
-    for fmt in formats:
-        if fmt not in WRITERS:
-            raise ColonsimError(f"unknown export format {fmt!r}; use {', '.join(FORMATS)}")
-        try:
-            _check(fmt, law)
-        except ColonsimError as exc:
-            _refuse(fmt, law, str(exc))
+    try:
+        p = law.values(parameters)
+    except (KeyError, TypeError, ValueError) as exc:
+        raise ColonsimError(f"{law.name} takes the numbers {', '.join(law.parameter_names)} (Pa); got {parameters!r} "
+                            f"({type(exc).__name__}: {exc})") from None
+    if p.size != len(law.parameter_names):
+        raise ColonsimError(f"{law.name} takes {len(law.parameter_names)} parameters ({', '.join(law.parameter_names)}), "
+                            f"got {p.size}")
+    check_parameters(law, p)
+    options = options or CardOptions()
+    if fmt == "lsdyna" and options.poisson < LSDYNA_MIN_POISSON:
+        warnings.warn(ColonsimWarning(
+            f"LS-DYNA's manual recommends PR >= {LSDYNA_MIN_POISSON} for its rubber materials; the card's PR is "
+            f"{options.poisson:.4f} (K/mu0 {options.bulk_ratio:g}); choose K/mu0 >= 50 unless you have checked it"))
+    return WRITERS[fmt](law, p, options)
 
 
-def write_cards(formats, law_name, parameters, out_dir, density=DENSITY) -> list[Path]:
-    """Write ``material_<format>.<suffix>`` for each format into ``out_dir`` (all or none)."""
-    check_formats(formats, law_name)
-    texts = {fmt: card_text(fmt, law_name, parameters, density) for fmt in formats}
-    paths = [Path(out_dir) / f"material_{fmt}.{SUFFIX[fmt]}" for fmt in texts]
+def card_path(out_dir, fmt) -> Path:
+    return Path(out_dir) / f"material_{fmt}.{SUFFIX[fmt]}"
+
+
+_PARAMETER = re.compile(r"\b(\w+)=([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)")
+
+
+def card_material(path):
+    """(law, {name: value}) of the material a colonsim card at ``path`` was written from, read from
+    its comment lines; None when the file is not a colonsim card."""
+    try:
+        text = Path(path).read_text(encoding="utf-8")
+    except (OSError, UnicodeDecodeError):
+        return None
+    title = re.search(re.escape(CARD_TITLE) + r" \((\w+)\): law (\w+)", text)
+    if title is None or title.group(2) not in CALIBRATION_LAWS:
+        return None
+    names = CALIBRATION_LAWS[title.group(2)].parameter_names
+    start = text.find("colonsim parameters (Pa):")
+    found = {k: float(v) for k, v in _PARAMETER.findall(text[start:]) if k in names} if start >= 0 else {}
+    return title.group(2), found
+
+
+def read_material(path):
+    """(law, {name: value in Pa}) of a colonsim ``material.json``; one line if it is not one."""
+    doc = read_material_document(path)
+    law = doc.get("law")
+    if not isinstance(law, str):
+        raise ColonsimError(f"material file {path} has no law; pass a material.json of colonsim calibrate")
+    names = calibration_law(law).parameter_names
+    params = doc.get("parameters")
+    if not isinstance(params, dict) or any(n not in params for n in names) or doc.get("units", "Pa") != "Pa":
+        raise ColonsimError(f"material file {path} lacks the parameters {', '.join(names)} in Pa; regenerate it")
+    bad = [n for n in names if isinstance(params[n], bool) or not isinstance(params[n], (int, float))]
+    if bad:
+        raise ColonsimError(f"material file {path}: parameter {bad[0]} is {params[bad[0]]!r}, not a number; "
+                            "regenerate it")
+    return law, {n: float(params[n]) for n in names}
+
+
+def _same(a, b) -> bool:
+    return a[0] == b[0] and set(a[1]) == set(b[1]) and all(a[1][n] == b[1][n] for n in a[1])
+
+
+def _stale(path, material) -> bool:
+    found = card_material(path) if path.is_file() else None
+    return found is not None and not _same(found, material)
+
+
+def folder_card_formats(formats, law_name, parameters, out_dir, source=None) -> list[str]:
+    """The formats an export of this material into ``out_dir`` writes: ``formats``, then every
+    format whose colonsim card there was written from another material (so that the folder's
+    cards stay one set). Refuses a folder whose ``material.json`` (other than ``source``) holds
+    another material."""
+    out_dir = Path(out_dir)
+    law = calibration_law(law_name)
+    material = (law.name, dict(zip(law.parameter_names, (float(v) for v in law.values(parameters)))))
+    held = out_dir / "material.json"
+    if held.is_file() and (source is None or Path(source).resolve() != held.resolve()):
+        other = read_material(held)
+        if not _same(other, material):
+            raise ColonsimError(f"{out_dir} holds the material.json of another material (law {other[0]}); cards of "
+                                f"this one there would disagree with it: export into another folder (--out)")
+    stale = [f for f in FORMATS if f not in formats and _stale(card_path(out_dir, f), material)]
+    return list(dict.fromkeys([*formats, *stale]))
+
+
+def write_cards(formats, law_name, parameters, out_dir, options: CardOptions | None = None, source=None) -> list[Path]:
+    """Write ``material_<format>.<suffix>`` for each format into ``out_dir``, with the cards there
+    that :func:`folder_card_formats` finds stale, all replaced together or none."""
+    formats = folder_card_formats(formats, law_name, parameters, out_dir, source)
+    check_formats(formats, [law_name])
+    texts = {fmt: card_text(fmt, law_name, parameters, options) for fmt in formats}
+    paths = [card_path(out_dir, fmt) for fmt in texts]
     with atomic_paths(*paths) as temps:
         for tmp, text in zip(temps, texts.values()):
-            Path(tmp).write_text(text)
+            Path(tmp).write_text(text, encoding="utf-8")
     return paths

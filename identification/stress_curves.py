@@ -6,8 +6,9 @@ stress column, both named with what they are:
 - deformation: ``stretch`` (l) or ``strain`` (engineering strain l - 1; ``strain [%]`` in per cent);
 - stress: ``nominal_stress [unit]`` (force per undeformed area, first Piola) or
   ``cauchy_stress [unit]`` / ``true_stress [unit]`` (force per deformed area), unit one of
-  :data:`STRESS_UNITS`. A column named only ``stress`` takes its measure from the option
-  (``--stress-measure``); the measure is never guessed.
+  :data:`STRESS_UNITS`, in brackets or after an underscore (``nominal_stress_MPa``). A column
+  named only ``stress`` takes its measure from the option (``--stress-measure``); the measure is
+  never guessed.
 
 Cauchy stress becomes nominal stress by ``P = sigma / l`` in all three modes (the loaded
 direction's cross-section shrinks by ``l`` in each: uniaxial, equibiaxial and planar alike, J = 1).
@@ -33,7 +34,9 @@ from colonsim.identification.testdata import TensileCurve, check_input_file, rea
 
 STRESS_UNITS = {"pa": 1.0, "kpa": 1e3, "mpa": 1e6, "n/mm2": 1e6, "gpa": 1e9, "kgf/cm2": 9.80665e4, "psi": 6894.757293168}
 STRESS_MEASURES = {"nominal": "nominal", "cauchy": "cauchy", "true": "cauchy"}
-_COLUMN = re.compile(r"^\s*(?P<name>[a-z_ ]+?)\s*(?:\[(?P<unit>[^\]]*)\])?\s*$", re.IGNORECASE)
+# "nominal_stress [MPa]", or the unit after an underscore ("nominal_stress_MPa") when it is a known one
+_COLUMN = re.compile(r"^\s*(?P<name>[a-z_ ]+?)\s*(?:\[(?P<unit>[^\]]*)\]|_(?P<suffix>"
+                     + "|".join(re.escape(u) for u in STRESS_UNITS) + r"))?\s*$", re.IGNORECASE)
 
 
 @dataclass(frozen=True)
@@ -152,7 +155,8 @@ def read_stress_curve(path, mode, name=None, stress_measure=None, weight=1.0) ->
         raise ColonsimError(f"{path}: expected one stress column beside '{header[d_col]}', found "
                             f"{len(s_cols) or 'none'}; name it e.g. 'nominal_stress [MPa]'")
     m = _COLUMN.match(header[s_cols[0]])
-    measure, factor, unit = _stress_column(path, m.group("name").strip(), m.group("unit"), stress_measure)
+    measure, factor, unit = _stress_column(path, m.group("name").strip(), m.group("unit") or m.group("suffix"),
+                                           stress_measure)
     d_unit = (_COLUMN.match(header[d_col]).group("unit") or "").strip()
     try:
         values = np.array([[float(r[d_col]), float(r[s_cols[0]])] for r in rows], dtype=float)

@@ -176,3 +176,18 @@ def test_geometry_errors_quote_mm_and_folders_are_not_missing_files(tmp_path):
         read_curve(tmp_path, **GEOM)
     with pytest.raises(ColonsimError, match="is a folder, not a file"):
         read_manifest(tmp_path)
+
+
+@pytest.mark.parametrize("header", ["stretch,nominal_stress_MPa", "stretch,nominal_stress [MPa]", "Stretch,Nominal_Stress_mpa"])
+def test_a_stress_curve_with_the_unit_after_an_underscore_and_the_unloaded_state_first(tmp_path, header):
+    """The layout of published data sets: ``stretch,nominal_stress_MPa`` and a first row at stretch 1, stress 0."""
+    from colonsim.identification.stress_curves import read_stress_curve
+
+    p = tmp_path / "uniaxial.csv"
+    p.write_text(f"{header}\n1,0\n1.5,0.3\n2,0.7\n3,2.2\n")
+    c = read_stress_curve(p, "uniaxial")
+    np.testing.assert_allclose(c.stretch, [1.0, 1.5, 2.0, 3.0])
+    np.testing.assert_allclose(c.stress, [0.0, 3e5, 7e5, 2.2e6])
+    p.write_text("stretch,nominal_stress_furlong\n1,0\n1.5,0.3\n2,0.7\n")
+    with pytest.raises(ColonsimError, match="the stress unit is not stated"):
+        read_stress_curve(p, "uniaxial")
