@@ -47,14 +47,14 @@ SNAP_DYNAMIC = "a run with snap-throughs: judged on their count, the largest def
 def neutral_end(row) -> bool:
     """Whether a run ended with its tip held back at mu = 0 (docs/quasi_static.md, "Rate and mesh"):
     frictionless, a distal resistance acting, and pushed until its available length was used."""
-    resistance = row.get("distal_resistance_N")
-    return (float(row["friction"]) == 0.0 and resistance is not None and float(resistance) > 0.0
+    friction, resistance = row.get("friction"), row.get("distal_resistance_N")
+    return (friction is not None and float(friction) == 0.0 and resistance is not None and float(resistance) > 0.0
             and row.get("ended_by") == "length_used")
 
 
 def _snaps(row):
     value = _number(row, "snap_throughs")
-    return 0 if value is None else int(value)
+    return 0 if value is None or not math.isfinite(value) else int(value)
 
 
 def _number(row, column):

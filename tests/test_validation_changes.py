@@ -30,7 +30,8 @@ def test_a_moved_run_and_a_flipped_verdict_are_listed_and_an_unmoved_run_is_not(
     assert final["moved"] and abs(final["change"] - 0.6042) < 1e-3
     assert not largest["moved"]  # +0.2 %: below the 1 % that counts as moved
     assert section["flips"] == [{"check": "rate", "run": "RSF UTC (9.2 mm) alpha 45 deg, push 0.15 m/s",
-                                 "quantity": "final", "before": 0.071, "after": 0.002, "verdict": "FAIL -> pass"}]
+                                 "quantity": "final", "before": 0.071, "after": 0.002, "verdict": "FAIL -> pass",
+                                 "rule": "its numbers moved"}]
     text = "\n".join(changes.markdown(section))
     assert "and 0 of the distal resistance sweep), 1 moved" in text and "FAIL -> pass" in text
 
@@ -70,7 +71,7 @@ def test_the_distal_resistance_runs_their_rate_pairs_and_claims_are_compared():
     assert abs(moved[0]["quantities"][0]["change"] - (3.52 / 3.06 - 1)) < 1e-9
     assert section["flips"] == [{"check": "rate (resistance sweep)", "run": "RSF SDC (13.3 mm) alpha 45 deg, 10 N",
                                  "quantity": "final_deformation_cm", "before": 0.012, "after": 0.071,
-                                 "verdict": "pass -> FAIL"}]
+                                 "verdict": "pass -> FAIL", "rule": "its numbers moved"}]
     claims = {r["what"]: (r["before"], r["after"]) for r in section["summaries"] if "claims" in r["what"]}
     assert claims["resistance sweep: the source's claims reproduced on the final deformation at 10 N"] == (1, 2)
     text = "\n".join(changes.markdown(section))
@@ -111,3 +112,21 @@ def test_a_quantity_below_its_floor_is_not_counted_as_compared():
         doc["rate_check"]["rows"][0]["quantities"].append({"quantity": "max", "change": None, "passed": None})
     counts = changes.changes(before, after)["pair_counts"]
     assert counts["before"]["rate"] == (0, 1) and counts["after"]["rate"] == (1, 1)
+
+
+def test_a_verdict_changed_by_a_rule_names_the_rule():
+    """A quantity a rule leaves unjudged now, and one judged only since the rules, say why; a quantity
+    whose values moved says that instead."""
+    def doc(quantities):
+        return {"rate_check": {"rows": [{"segment": "thf", "scope": "SDC (13.3 mm)", "inputs": "beta 45 deg",
+                                          "quantities": quantities}]}}
+
+    why = "final deformation of a loop behind a tip held at mu 0: a nearly neutral end state"
+    before = doc([{"quantity": "final", "change": 0.08, "passed": False},
+                  {"quantity": "max", "change": 0.01, "passed": True}])
+    after = doc([{"quantity": "final", "change": 0.08, "passed": None, "why": why},
+                 {"quantity": "max", "change": 0.06, "passed": False, "why": ""},
+                 {"quantity": "lag", "change": 0.01, "passed": True, "why": ""}])
+    flips = {f["quantity"]: (f["verdict"], f["rule"]) for f in changes.changes(before, after)["flips"]}
+    assert flips == {"final": ("FAIL -> not judged", why), "max": ("pass -> FAIL", "its numbers moved"),
+                     "lag": ("not judged -> pass", "judged since the rules of 2026-12-07: the largest lag")}
