@@ -7,7 +7,6 @@ from __future__ import annotations
 
 from colonsim import catalog
 from colonsim.errors import ColonsimError
-from colonsim.surrogate.domain import EXTRAPOLATED
 
 # command-line option -> results-table column
 RAW_OPTIONS = {"scope_diameter": "scope_diameter_mm", "diameter": "diameter_mm", "angle": "angle_deg",
@@ -119,6 +118,7 @@ def error_of(note, target):
 
 
 def format_predictions(out, targets):
+    from colonsim.surrogate.domain import EXTRAPOLATED
     from colonsim.surrogate.table import INPUTS, target_unit
 
     lines = []

@@ -366,8 +366,8 @@ class SweepSurrogate:
             for target, why in self.skipped_[seg].items():
                 lines.append(f"  {target:<22} no model: {why}")
         if getattr(self, "tissue_", None) is not None and any(tissue_inputs(d) for d in self.domains_.values()):
-            lines.append(f"tissue: predictions without wall_mu0_kPa / wall_C11_kPa average over "
-                         f"{self.tissue_.description}")
+            given = sorted({c for d in self.domains_.values() for c in tissue_inputs(d)}, key=TISSUE_INPUTS.index)
+            lines.append(f"tissue: predictions without {' / '.join(given)} average over {self.tissue_.description}")
         lines.extend(f"note: {n}" for n in self.notes_)
         if self.domains_:
             scheme = next((self.cv_[s][t].get("scheme") for s in self.models_ for t, gp in self.models_[s].items()

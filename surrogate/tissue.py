@@ -217,8 +217,10 @@ def plan(domain, query: dict, n: int, distribution: TissueDistribution | None, s
     filled = dict(query)
     for c, k in zip(columns, j):  # the domain check of the other inputs sees a tissue inside the range
         filled[c] = np.where(full, given[:, columns.index(c)], 0.5 * (domain.low[k] + domain.high[k]))
-    note = (f"averaged over {len(draws)} {'draws' if distribution.kind == 'posterior' else 'materials'} of "
-            f"{distribution.description}" + (f"; {100 * outside:.0f} % of them outside the runs' tissue range "
+    what = (f"tissue: {distribution.description}" if len(draws) == 1 else
+            f"averaged over {len(draws)} {'draws' if distribution.kind == 'posterior' else 'materials'} of "
+            f"{distribution.description}")
+    note = (what + (f"; {100 * outside:.0f} % of them outside the runs' tissue range "
                                                "(extrapolated)" if outside > 0 else ""))
     return filled, TissuePlan(columns, full, draws, note, outside)
 
