@@ -239,3 +239,28 @@ def test_the_held_out_table_passes_honest_runs_and_fails_biased_ones(shipped):
     assert not any(r["coverage_95_ok"] or r["coverage_50_ok"] for r in biased)
     table = bench_predictor.format_table(rows + biased)
     assert "| RSF | max_deformation_cm | 38 (2 tip-folded left out) |" in table and "FAILS" in table
+
+
+
+def test_the_bench_prints_the_table_and_says_in_one_line_when_there_is_nothing_to_score(shipped, tmp_path, capsys,
+                                                                                          monkeypatch):
+    synthetic_patient_table(n=40, seed=3, shrink=0.05).to_parquet(tmp_path / "heldout.parquet")
+    args = ["--model", str(shipped.with_suffix(".json")), "--heldout", str(tmp_path / "heldout.parquet")]
+    assert bench_predictor.main([*args, "--json", str(tmp_path / "table.json")]) == 0
+    assert "| RSF | final_deformation_cm | 40 |" in capsys.readouterr().out
+    assert len(json.loads((tmp_path / "table.json").read_text())["rows"]) == 2
+    monkeypatch.setattr(predictor, "SHIPPED", tmp_path / "none")
+    assert bench_predictor.main(["--heldout", str(tmp_path / "heldout.parquet")]) == 2
+    assert capsys.readouterr().err.strip() == f"bench_predictor: {NO_SHIPPED}"
+
+@pytest.mark.skipif(not predictor.shipped_exists() or not bench_predictor.RECORD.exists(),
+                    reason="no predictor is shipped yet (the patient-space sweeps have not been run)")
+def test_the_shipped_predictor_reproduces_its_committed_held_out_table():
+    committed = json.loads(bench_predictor.RECORD.read_text())["rows"]
+    table = bench_predictor.table_of(bench_predictor.records_of("heldout"), "heldout")
+    replicates = bench_predictor.records_of("replicates")
+    rows = bench_predictor.predictor_table(load_shipped(), table, bench_predictor.table_of(replicates, "replicates")
+                                           if replicates else None)
+    assert [(r["model"], r["output"], r["runs"], r["coverage_95_ok"], r["coverage_50_ok"]) for r in rows] == \
+        [(r["model"], r["output"], r["runs"], r["coverage_95_ok"], r["coverage_50_ok"]) for r in committed]
+    assert [r["rmse"] for r in rows] == pytest.approx([r["rmse"] for r in committed], rel=1e-6)
