@@ -21,7 +21,8 @@ from colonsim.insertion.case.scenario import InsertionCase
 from colonsim.insertion.study.material_samples import material_columns
 from colonsim.insertion.study.sweep_presets import PATIENT_MODELS, PATIENT_PARTS, PATIENT_RANGES, PRESETS, patient_space
 from colonsim.insertion.study.sweep_spec import case_fields, parse_sweep
-from colonsim.insertion.study.tissue_stiffness import shape_mismatch, stiffness_factor
+from colonsim.insertion.study.tissue_stiffness import STRETCHES, shape_mismatch, stiffness_factor, uniaxial_stress
+from colonsim.laws import get_wall_law
 from colonsim.surrogate import predictor
 from colonsim.surrogate.domain import OutOfDomainWarning
 from colonsim.surrogate.model import SweepSurrogate
@@ -72,6 +73,15 @@ def test_the_reference_scaled_maps_back_to_its_factor_and_the_specimens_span_0_7
     assert low < factors.min() and factors.max() < high
     # another law with another curve shape: its level maps, its shape is said to differ
     assert shape_mismatch("neo_hookean", [[20_000.0]])[0] > 0.1
+
+
+@pytest.mark.parametrize("law,rows", [("yeoh", [[20e3, 5e3, 1e3], [30e3, 1e3, 4e3], [1e3, 1e3, 1e3]]),
+                                      ("ogden_1", [[30e3, 8.0], [20e3, 4.0], [40e3, 12.0]])])
+def test_many_materials_map_as_each_alone(law, rows):
+    """A batch of draws (combined per parameter for a law linear in them) maps as each row alone."""
+    model = get_wall_law(law)
+    alone = [model.uniaxial_nominal_stress(STRETCHES, tuple(row)) for row in rows]
+    assert uniaxial_stress(law, rows) == pytest.approx(np.array(alone), rel=1e-10)
 
 
 def test_a_stiffness_factor_scales_every_parameter_of_the_reference():

@@ -27,7 +27,7 @@ from functools import lru_cache
 import numpy as np
 
 from colonsim.catalog import TISSUE_STIFFNESS
-from colonsim.laws import get_wall_law
+from colonsim.laws import OgdenLaw, get_wall_law
 from colonsim.insertion.engine.material import REFERENCE_MATERIAL_PATH, load_material
 
 STIFFNESS = TISSUE_STIFFNESS  # the results-table column and surrogate input
@@ -45,10 +45,22 @@ def _reference_stress():
 
 
 def uniaxial_stress(law: str, parameters) -> np.ndarray:
-    """Nominal uniaxial stress (Pa) of ``law`` at :data:`STRETCHES`, one row per parameter row (n, k)."""
+    """Nominal uniaxial stress (Pa) of ``law`` at :data:`STRETCHES`, one row per parameter row (n, k).
+
+    A law whose energy is linear in its parameters (every invariant law of :mod:`colonsim.laws`)
+    is evaluated once per parameter and combined, checked on the first row: a tissue distribution
+    maps its thousand draws in a millisecond instead of a fifth of a second."""
     model = get_wall_law(law)
     rows = np.atleast_2d(np.asarray(parameters, dtype=float))
-    return np.array([model.uniaxial_nominal_stress(STRETCHES, tuple(row)) for row in rows])
+
+    def one(row):
+        return model.uniaxial_nominal_stress(STRETCHES, tuple(row))
+
+    if len(rows) > 1 and not isinstance(model, OgdenLaw):  # Ogden's exponents are no linear parameters
+        basis = np.array([one(unit) for unit in np.eye(rows.shape[1])])  # (p, k): each parameter's stress alone
+        if np.allclose(rows[0] @ basis, one(rows[0]), rtol=1e-9, atol=0.0):
+            return rows @ basis
+    return np.array([one(row) for row in rows])
 
 
 def stiffness_factor(law: str, parameters) -> np.ndarray:
