@@ -99,7 +99,7 @@ def add_parsers(sub):
     fit.set_defaults(func=cmd_fit)
 
     info = ssub.add_parser("info", help="training domain, hyperparameters and cross-validated accuracy of a model")
-    info.add_argument("model", type=Path)
+    info.add_argument("model", type=Path, nargs="?", help=MODEL_HELP.split(", which")[0] + ")")
     info.add_argument("--json", action="store_true", help="print the model's JSON document")
     info.set_defaults(func=cmd_info)
 
@@ -120,7 +120,7 @@ def add_parsers(sub):
     plot = ssub.add_parser("plot", help="predicted output against one input, with its 95 %% band",
                            description="One curve per scope over the input's training range; the other inputs "
                                        "from the patient options.")
-    plot.add_argument("model", type=Path)
+    plot.add_argument("model", type=Path, nargs="?", help=MODEL_HELP)
     plot.add_argument("--vs", required=True, help="scope, diameter, angle, friction or wall-thickness")
     plot.add_argument("--target", default=catalog.PAIN_PROXY, help=f"output column (default {catalog.PAIN_PROXY}, the pain proxy)")
     _patient_options(plot)
@@ -191,13 +191,19 @@ def cmd_fit(args):
 
 
 def cmd_info(args):
+    from colonsim.surrogate.predictor import SHIPPED, load_shipped
     from colonsim.surrogate.store import load_surrogate, model_paths
 
-    model = load_surrogate(args.model)
+    model = load_shipped() if args.model is None else load_surrogate(args.model)
     if args.json:
-        print(model_paths(args.model)[0].read_text(encoding="utf-8"), end="")
-    else:
-        print(model.report())
+        print(model_paths(SHIPPED if args.model is None else args.model)[0].read_text(encoding="utf-8"), end="")
+        return
+    about = getattr(model, "about_", None)
+    if about:
+        print(f"{about['what']}; fitted on {', '.join(about['sweeps'])} (held out: "
+              f"{', '.join(about['held_out_sweeps']) or 'none'}) by the engine of "
+              f"{', '.join(c[:10] for c in about['engine_commits']) or 'unknown commits'}")
+    print(model.report())
 
 
 def cmd_validate(args):

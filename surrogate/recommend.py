@@ -161,6 +161,6 @@ def format_recommendation(rec) -> str:
     else:
         split = ", ".join(f"{s['scope'].upper()} tissue {s['std_tissue']:.2g}, surrogate {s['std_surrogate']:.2g}"
                           for s in rec["scopes"])
-        lines.append(f"  uncertainty split (sd, {unit}): {split}; {tissue['note']}")
+        lines.append(f"  {mark}uncertainty split (sd, {unit}): {split}; {tissue['note']}")
     lines.append(f"  ({rec['uncertainty']}; the model rests on {rec['n_runs']} runs)")
     return "\n".join(lines)

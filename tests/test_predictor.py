@@ -151,6 +151,8 @@ def test_without_a_shipped_model_the_call_says_so_and_how_to_fit_one(tmp_path, m
     err = capsys.readouterr().err.strip()
     assert err == f"colonsim: error: {NO_SHIPPED}"
     assert main(["recommend", "--segment", "rsf", "--angle", "45"]) == 2
+    assert main(["surrogate", "info"]) == 2
+    assert capsys.readouterr().err.count("ships no fitted predictor") == 2
 
 
 def test_the_shipped_model_names_its_sweeps_engine_and_domain_and_left_out_folded_tips(shipped):
@@ -229,7 +231,10 @@ def test_the_cli_uses_the_shipped_model_and_marks_every_extrapolated_number(ship
     assert main(["recommend", *far, "--extrapolate"]) == 0
     text = capsys.readouterr().out
     assert text.startswith("[EXTRAPOLATED] RSF") and all("[EXTRAPOLATED]" in line for line in text.splitlines()
-                                                        if " mm): " in line)
+                                                        if " mm): " in line or "sd, cm" in line)
+    assert main(["surrogate", "info"]) == 0
+    assert "; fitted on patient_space_rsf (held out: patient_space_rsf_heldout) by the engine of 0123abc" in \
+        capsys.readouterr().out.splitlines()[0]
     assert main(["predict", *patient, "--scope", "9.2", "--material",
                  str(material_file(tmp_path / "m.json", 3.0))]) == 2
     assert "tissue stiffness 3 outside" in capsys.readouterr().err
