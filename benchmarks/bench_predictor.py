@@ -119,7 +119,8 @@ def format_table(rows) -> str:
         scatter = "-" if math.isnan(r["scatter_sd"]) else f"{r['scatter_sd']:.3g}"
         left = [f"{r[k]} {what}" for k, what in (("tip_folded_left_out", "tip-folded"), ("failed_left_out", "failed"))
                 if r[k]]
-        lines.append(f"| {r['model'].upper()} | {r['output']} | {r['runs']}{' (' + ', '.join(left) + ' left out)' if left else ''} | "
+        runs = f"{r['runs']}" + (f" ({', '.join(left)} left out)" if left else "")
+        lines.append(f"| {r['model'].upper()} | {r['output']} | {runs} | "
                      f"{100 * r['coverage_95']:.0f} %{verdict(r['coverage_95_ok'])} | "
                      f"{100 * r['coverage_50']:.0f} %{verdict(r['coverage_50_ok'])} | {r['rmse']:.3g} | "
                      f"{r['spread_sd']:.3g} | {scatter} ({r['scatter_from']}) |")

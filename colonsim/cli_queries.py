@@ -125,7 +125,8 @@ def format_predictions(out, targets):
     for _, row in out.iterrows():
         inputs = ", ".join(f"{c} {row[c]:g}" for c in INPUTS if c in row and row[c] is not None and row[c] == row[c])
         scope = f" {str(row['scope']).upper()}" if "scope" in row and isinstance(row["scope"], str) else ""
-        lines.append(f"{row['segment'].upper()}{scope}: {inputs}" + ("" if row["in_domain"] else f"  [OUTSIDE the training domain: {row['domain_note']}]"))
+        outside = "" if row["in_domain"] else f"  [OUTSIDE the training domain: {row['domain_note']}]"
+        lines.append(f"{row['segment'].upper()}{scope}: {inputs}{outside}")
         for t in targets:
             if row[t] == row[t]:
                 unit = target_unit(t)

@@ -2,8 +2,9 @@
 
 The predictor is a :class:`SweepSurrogate` of the patient models (RSJ, RSF, THF) fitted on the
 training sweeps' results (presets ``patient_space_rsj``, ``_rsf``, ``_thf``), with their tip-folded
-runs left out and counted, the noise floor of each output from the replicate sweeps (``_replicates``), and the reference wall (tissue stiffness 1) as the tissue of a query
-that names none. Its JSON says what it is (``about``): the sweeps it was fitted on and those held
+runs left out and counted, the noise floor of each output from the replicate sweeps
+(``_replicates``), and the reference wall (tissue stiffness 1) as the tissue of a query that names
+none. Its JSON says what it is (``about``): the sweeps it was fitted on and those held
 out, the engine commits of the runs, the training domain of each model, the runs left out.
 """
 
