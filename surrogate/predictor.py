@@ -19,6 +19,7 @@ Example (the shipped model; a model fitted on any patient-space table answers th
 from __future__ import annotations
 
 import copy
+from pathlib import Path
 
 import numpy as np
 import pandas as pd
@@ -60,13 +61,17 @@ def load_shipped(path=None):
 
 
 def with_material(model, material):
-    """A copy of ``model`` whose tissue is the calibration ``material`` (a path), and a note on
-    how well the stiffness factor stands for it ("" when it does)."""
+    """A copy of ``model`` whose tissue is the calibration ``material`` (a path), and a note: the
+    stiffness factor it maps to (mean and sd over its distribution) and, where its curve has
+    another shape than the reference wall's, by how much."""
     distribution = TissueDistribution.from_file(material)
     wall = case_material(str(material))
     mismatch = float(shape_mismatch(wall.law, [wall.parameters])[0])
-    note = (f"the stress curve of {material} departs from the reference wall's shape by {100 * mismatch:.0f} % "
-            "(RMS); the stiffness factor carries its level, not its shape" if mismatch > MISMATCH_NOTE else "")
+    factors = distribution.draws()[TISSUE_STIFFNESS]
+    note = f"{Path(material).name} maps to tissue stiffness {np.mean(factors):.3g} (sd {np.std(factors):.2g})"
+    if mismatch > MISMATCH_NOTE:
+        note += (f"; its stress curve departs from the reference wall's shape by {100 * mismatch:.0f} % (RMS): the "
+                 "stiffness factor carries its level, not its shape")
     model = copy.copy(model)
     model.tissue_ = distribution
     return model, note

@@ -193,6 +193,14 @@ def test_a_material_maps_to_its_stiffness_with_its_uncertainty_in_the_interval(s
     mapped = predict_deformation("rsf", "pdc", material=material_file(tmp_path / "m.json", 1.2), **query).iloc[0]
     assert mapped["max_deformation_cm"] == pytest.approx(given["max_deformation_cm"], abs=0.02)
     assert mapped["max_deformation_cm_std_tissue"] > 0 == given["max_deformation_cm_std_tissue"]
+    assert "m.json maps to tissue stiffness 1.2 (sd 0.0" in mapped["tissue_note"]
+    assert "departs from the reference" not in mapped["tissue_note"]
+    other = tmp_path / "nh.json"  # a neo-Hookean wall: another shape than the reference's, said so
+    other.write_text(json.dumps({"format": "colonsim-material/1", "law": "neo_hookean", "units": "Pa",
+                                 "parameters": {"C10": 40_000.0}}))
+    with pytest.warns(OutOfDomainWarning):
+        note = predict_deformation("rsf", "pdc", material=other, extrapolate=True, **query).iloc[0]["tissue_note"]
+    assert "departs from the reference wall's shape by" in note
     point = predict_deformation("rsf", "pdc", material=material_file(tmp_path / "p.json", 1.2, covariance=False),
                                 **query).iloc[0]
     assert point["max_deformation_cm_std_tissue"] == 0 and "no parameter uncertainty" in point["tissue_note"]
