@@ -277,6 +277,9 @@ SURROGATE_INPUT, DEFAULT_TARGET, TARGET = "input", "default target", "target"
 # The wall material of a run as the surrogate sees it: its small-strain shear modulus and its C11
 # (colonsim.insertion.study.material_samples fills both for every run, the default material too).
 WALL_MU0, WALL_C11 = "wall_mu0_kPa", "wall_C11_kPa"
+# ... and as one number, the factor on the reference wall law it amounts to
+# (colonsim.insertion.study.tissue_stiffness: definition and mapping rule)
+TISSUE_STIFFNESS = "tissue_stiffness"
 
 
 @dataclass(frozen=True)
@@ -337,6 +340,9 @@ COLUMNS = {c.name: c for c in (
            SURROGATE_INPUT, "wall shear modulus mu0 [kPa]", "--wall-mu0"),
     Column(WALL_C11, _I, "kPa", "C11 of the run's wall material (NaN for a law without a C11 term)", SURROGATE_INPUT,
            "wall C11 [kPa]", "--wall-c11"),
+    Column(TISSUE_STIFFNESS, _I, "", "the run's wall material as a factor on the reference wall law (1: the reference; "
+                                     "colonsim.insertion.study.tissue_stiffness)", SURROGATE_INPUT,
+           "tissue stiffness factor", "--stiffness"),
     Column("element_size_mm", _S, "mm", "wall triangle size"),
     Column("scope_spacing_mm", _S, "mm", "scope node spacing"),
     Column("push_speed", _S, "m/s", "plateau push speed"),

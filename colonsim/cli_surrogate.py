@@ -12,18 +12,20 @@ import json
 from pathlib import Path
 
 from colonsim import catalog, options
+from colonsim.cli_queries import (format_predictions, load_model, patient_query, presets_of, query_frame, records,
+                                  segment_of as _segment)
 from colonsim.errors import ColonsimError
 from colonsim.options import bounded_int, finite_float, output_file, seed, worker_count
 
-# command-line option -> results-table column
-RAW_OPTIONS = {"scope_diameter": "scope_diameter_mm", "diameter": "diameter_mm", "angle": "angle_deg",
-               "friction": "friction", "wall_thickness": "wall_thickness_mm", "wall_mu0": catalog.WALL_MU0,
-               "wall_c11": catalog.WALL_C11, "distal_resistance": "distal_resistance_N"}
 VS_NAMES = {"scope": "scope_diameter_mm", "scope-diameter": "scope_diameter_mm", "diameter": "diameter_mm",
             "angle": "angle_deg", "friction": "friction", "wall-thickness": "wall_thickness_mm",
-            "wall-mu0": catalog.WALL_MU0, "wall-c11": catalog.WALL_C11, "distal-resistance": "distal_resistance_N"}
+            "wall-mu0": catalog.WALL_MU0, "wall-c11": catalog.WALL_C11, "distal-resistance": "distal_resistance_N",
+            "stiffness": catalog.TISSUE_STIFFNESS}
 MATERIAL_HELP = ("calibration file of the tissue distribution predictions average over: a material.json (its "
-                 "posterior) or a population.json (its specimens); default: the one the sweep sampled")
+                 "posterior; a model over the tissue stiffness maps it to the stiffness factor) or a population.json "
+                 "(its specimens); default: the one the sweep sampled, the reference wall for the shipped predictor")
+MODEL_HELP = ("MODEL.json written by 'colonsim surrogate fit' (default: the predictor shipped with colonsim, which "
+              "refuses a query outside its training domain unless --extrapolate)")
 
 
 def _cv(text):
@@ -56,8 +58,14 @@ def _patient_options(p, scope_diameter=True):
                    help="force the colon beyond the model opposes to the tip, N (docs/model.md, \"Loading\")")
     g.add_argument("--wall-mu0", type=finite_float, help="a known wall's small-strain shear modulus, kPa (with --wall-c11)")
     g.add_argument("--wall-c11", type=finite_float, help="a known wall's C11, kPa (without both: averaged over the tissue)")
+    g.add_argument("--stiffness", type=finite_float,
+                   help="the wall as a factor on the reference wall law (1: the reference), for a model fitted "
+                        "over it, such as the shipped predictor")
     g.add_argument("--material", type=Path, help=MATERIAL_HELP)
     g.add_argument("--strict", action="store_true", help="a query outside the training domain is an error, not a warning")
+    g.add_argument("--extrapolate", action="store_true",
+                   help="answer outside the training domain too, every such number marked (the shipped predictor "
+                        "refuses without it)")
 
 
 def add_parsers(sub):
@@ -91,7 +99,7 @@ def add_parsers(sub):
     fit.set_defaults(func=cmd_fit)
 
     info = ssub.add_parser("info", help="training domain, hyperparameters and cross-validated accuracy of a model")
-    info.add_argument("model", type=Path)
+    info.add_argument("model", type=Path, nargs="?", help=MODEL_HELP.split(", which")[0] + ")")
     info.add_argument("--json", action="store_true", help="print the model's JSON document")
     info.set_defaults(func=cmd_info)
 
@@ -112,7 +120,7 @@ def add_parsers(sub):
     plot = ssub.add_parser("plot", help="predicted output against one input, with its 95 %% band",
                            description="One curve per scope over the input's training range; the other inputs "
                                        "from the patient options.")
-    plot.add_argument("model", type=Path)
+    plot.add_argument("model", type=Path, nargs="?", help=MODEL_HELP)
     plot.add_argument("--vs", required=True, help="scope, diameter, angle, friction or wall-thickness")
     plot.add_argument("--target", default=catalog.PAIN_PROXY, help=f"output column (default {catalog.PAIN_PROXY}, the pain proxy)")
     _patient_options(plot)
@@ -123,7 +131,7 @@ def add_parsers(sub):
     pr = sub.add_parser("predict", help="predict deformation, forces and stretch from a surrogate",
                         description="Mean, standard deviation and 95 % interval of each output for the query, "
                                     "or for every row of --csv.")
-    pr.add_argument("model", type=Path, help="MODEL.json written by 'colonsim surrogate fit'")
+    pr.add_argument("model", type=Path, nargs="?", help=MODEL_HELP)
     _patient_options(pr)
     pr.add_argument("--target", nargs="+", help="outputs to predict (default: all the model has)")
     pr.add_argument("--csv", type=Path, help="batch queries: one per row, columns segment, scope or "
@@ -136,7 +144,7 @@ def add_parsers(sub):
     rec = sub.add_parser("recommend", help="rank the scopes for a patient by predicted deformation",
                          description="Ranks scopes by predicted deformation and states the probability of the "
                                      "ranking from the joint GP posterior (docs/surrogate.md).")
-    rec.add_argument("model", type=Path)
+    rec.add_argument("model", type=Path, nargs="?", help=MODEL_HELP)
     _patient_options(rec, scope_diameter=False)
     rec.add_argument("--target", default=catalog.PAIN_PROXY, help=f"output to rank by (default {catalog.PAIN_PROXY}, the largest "
                      "deformation over the run: docs/surrogate.md, 'The pain proxy'; final_deformation_cm is the end value)")
@@ -154,6 +162,13 @@ def _model_path(text):
     for path in model_paths(text):
         file_type(str(path))
     return Path(text)
+
+
+def _tissue(args):
+    """The tissue distribution of --material, or None."""
+    from colonsim.surrogate.tissue import TissueDistribution
+
+    return None if args.material is None else TissueDistribution.from_file(args.material)
 
 
 def cmd_fit(args):
@@ -176,13 +191,19 @@ def cmd_fit(args):
 
 
 def cmd_info(args):
+    from colonsim.surrogate.predictor import SHIPPED, load_shipped
     from colonsim.surrogate.store import load_surrogate, model_paths
 
-    model = load_surrogate(args.model)
+    model = load_shipped() if args.model is None else load_surrogate(args.model)
     if args.json:
-        print(model_paths(args.model)[0].read_text(encoding="utf-8"), end="")
-    else:
-        print(model.report())
+        print(model_paths(SHIPPED if args.model is None else args.model)[0].read_text(encoding="utf-8"), end="")
+        return
+    about = getattr(model, "about_", None)
+    if about:
+        print(f"{about['what']}; fitted on {', '.join(about['sweeps'])} (held out: "
+              f"{', '.join(about['held_out_sweeps']) or 'none'}) by the engine of "
+              f"{', '.join(c[:10] for c in about['engine_commits']) or 'unknown commits'}")
+    print(model.report())
 
 
 def cmd_validate(args):
@@ -211,143 +232,27 @@ def cmd_validate(args):
             print(f"written: {path}")
 
 
-def _tissue(args):
-    """The tissue distribution of --material, or None."""
-    from colonsim.surrogate.tissue import TissueDistribution
+def _check_material(model, segments, strict):
+    from colonsim.surrogate.predictor import check_material
 
-    return None if args.material is None else TissueDistribution.from_file(args.material)
-
-
-def _load(args):
-    """The model of ``args.model``, with the tissue distribution of --material if given."""
-    from colonsim.surrogate.store import load_surrogate
-
-    model = load_surrogate(args.model)
-    if args.material is not None:
-        model.tissue_ = _tissue(args)
-    return model
-
-
-def _raw(args):
-    return {col: getattr(args, opt) for opt, col in RAW_OPTIONS.items() if getattr(args, opt, None) is not None}
-
-
-def _presets(args):
-    from colonsim.surrogate.patients import PatientPresets
-
-    return PatientPresets.from_json(args.presets) if args.presets else PatientPresets()
-
-
-def _segment(args, model):
-    if args.segment:
-        return args.segment.lower()
-    if len(model.domains_) == 1:
-        return next(iter(model.domains_))
-    raise ColonsimError(f"give --segment ({', '.join(model.domains_)})")
-
-
-def _patient_query(model, segment, args, presets):
-    """Model inputs from presets, then raw options on top."""
-    from colonsim.surrogate.patients import patient_inputs
-
-    return {**patient_inputs(segment, args.sex, args.age, args.region, presets), **_raw(args)}
-
-
-def _query_frame(args, model):
-    """One row per query: from --csv (options fill its missing columns) or from the options, one per scope."""
-    import io
-
-    import numpy as np
-    import pandas as pd
-
-    from colonsim.inputs import read_input_text
-    from colonsim.surrogate.patients import patient_inputs
-    from colonsim.surrogate.recommend import default_scopes
-
-    presets = _presets(args)
-    if args.csv:
-        text = read_input_text(args.csv, "query file")
-        try:
-            frame = pd.read_csv(io.StringIO(text))
-        except (pd.errors.ParserError, pd.errors.EmptyDataError, UnicodeDecodeError) as exc:
-            raise ColonsimError(f"cannot read {args.csv}: {str(exc).splitlines()[0]}") from None
-        if args.segment:
-            frame = frame.assign(segment=frame["segment"].fillna(args.segment) if "segment" in frame else args.segment)
-        elif "segment" not in frame and len(model.domains_) == 1:
-            frame["segment"] = next(iter(model.domains_))
-        if "segment" not in frame:
-            raise ColonsimError(f"{args.csv} has no segment column; add one or pass --segment")
-        frame["segment"] = frame["segment"].astype(str).str.lower()
-        for col, value in _raw(args).items():
-            frame[col] = frame[col].fillna(value) if col in frame else value
-        if args.scope and len(args.scope) > 1:
-            raise ColonsimError("with --csv give one --scope (or a scope column)")
-        if args.scope:
-            frame["scope"] = frame["scope"].fillna(args.scope[0]) if "scope" in frame else args.scope[0]
-        for i, row in frame.iterrows():  # presets per row, where the row leaves the input empty
-            p = patient_inputs(row["segment"], *(row.get(k) if isinstance(row.get(k), str) else getattr(args, k)
-                                                  for k in ("sex", "age", "region")), presets=presets)
-            for col, value in p.items():
-                if col not in frame or pd.isna(frame.at[i, col]):
-                    frame.loc[i, col] = value
-        return frame.drop(columns=[c for c in ("sex", "age", "region") if c in frame])
-    segment = _segment(args, model)
-    base = {"segment": segment, **_patient_query(model, segment, args, presets)}
-    scopes = args.scope
-    if not scopes and "scope_diameter_mm" not in base and segment in model.domains_:
-        domain = model.domains_[segment]
-        scopes = default_scopes(domain) if "scope_diameter_mm" in domain.inputs else None
-    rows = [{**base, "scope": s} for s in scopes] if scopes else [base]
-    return pd.DataFrame(rows).replace({np.nan: None})
-
-
-def _records(frame):
-    import numpy as np
-
-    return [{k: (None if isinstance(v, float) and np.isnan(v) else v) for k, v in row.items()}
-            for row in frame.to_dict(orient="records")]
-
-
-def _error_of(note, target):
-    """The reason ``error_note`` gives for ``target``."""
-    return next((part.split(": ", 1)[1] for part in note.split(". ") if part.startswith(target + ": ")), "")
-
-
-def _format_predictions(out, targets):
-    from colonsim.surrogate.table import INPUTS, target_unit
-
-    lines = []
-    for _, row in out.iterrows():
-        inputs = ", ".join(f"{c} {row[c]:g}" for c in INPUTS if c in row and row[c] is not None and row[c] == row[c])
-        scope = f" {str(row['scope']).upper()}" if "scope" in row and isinstance(row["scope"], str) else ""
-        lines.append(f"{row['segment'].upper()}{scope}: {inputs}" + ("" if row["in_domain"] else "  [OUTSIDE the training domain]"))
-        for t in targets:
-            if row[t] == row[t]:
-                unit = target_unit(t)
-                split = ("" if row[t + "_std_tissue"] != row[t + "_std_tissue"] else
-                         f"  sd: tissue {row[t + '_std_tissue']:.2g}, surrogate {row[t + '_std_surrogate']:.2g}")
-                if row[t + "_std"] != row[t + "_std"]:  # the model cannot vouch for a spread: no number
-                    lines.append(f"  {t:<22} {row[t]:8.4g} {unit}  (no interval: {_error_of(row['error_note'], t)})")
-                    continue
-                lines.append(f"  {t:<22} {row[t]:8.4g} +- {row[t + '_std']:.2g} {unit}  "
-                             f"(95 %: {row[t + '_low95']:.4g} to {row[t + '_high95']:.4g}){split}")
-        lines.append(f"  {row['tissue_note']}")
-    lines.append("(+- one standard deviation of a new simulation result, tissue and surrogate parts added in "
-                 "variance; the interval is mean +- 1.96 sd)")
-    return "\n".join(lines)
+    for segment in dict.fromkeys(segments):
+        check_material(model, segment, strict=strict)
 
 
 def cmd_predict(args):
     from colonsim.files import write_csv, write_json
     from colonsim.surrogate.model import SUFFIXES
 
-    model = _load(args)
-    frame = _query_frame(args, model)
+    model, strict, note = load_model(args)
+    frame = query_frame(args, model)
+    _check_material(model, frame["segment"], strict)
     targets = list(args.target or model.targets)
     unknown = sorted(set(targets) - set(model.targets))
     if unknown:
         raise ColonsimError(f"the surrogate has no target {', '.join(unknown)}; it models {', '.join(model.targets)}")
-    out = model.predict_frame(frame, targets=targets, strict=args.strict)
+    out = model.predict_frame(frame, targets=targets, strict=strict)
+    if note:
+        out["tissue_note"] = out["tissue_note"] + "; " + note
     out = out.drop(columns=[t + suffix for t in targets if out[t].isna().all() for suffix in SUFFIXES])
     shown = [t for t in targets if t in out]
     if not shown:
@@ -356,13 +261,13 @@ def cmd_predict(args):
         raise ColonsimError(f"no model for this query ({why})")
     if args.out:
         if args.out.suffix.lower() == ".json":
-            write_json(args.out, {"predictions": _records(out)})
+            write_json(args.out, {"predictions": records(out)})
         else:
             write_csv(args.out, out)
     if args.json:
-        print(json.dumps({"predictions": _records(out)}, indent=2, allow_nan=False, default=str))
+        print(json.dumps({"predictions": records(out)}, indent=2, allow_nan=False, default=str))
     else:
-        print(_format_predictions(out, shown))
+        print(format_predictions(out, shown))
         if args.out:
             print(f"predictions: {args.out}")
 
@@ -372,12 +277,15 @@ def cmd_recommend(args):
     from colonsim.surrogate.patients import describe_patient
     from colonsim.surrogate.recommend import format_recommendation, recommend
 
-    model = _load(args)
+    model, strict, note = load_model(args)
     segment = _segment(args, model)
-    query = _patient_query(model, segment, args, _presets(args))
+    _check_material(model, [segment], strict)
+    query = patient_query(model, segment, args, presets_of(args))
     rec = recommend(model, segment, query, scopes=args.scope, target=args.target, reference=args.reference,
-                    strict=args.strict)
-    patient = describe_patient(segment, args.sex, args.age, args.region, _presets(args))
+                    strict=strict)
+    if note:
+        rec["tissue"]["note"] += "; " + note
+    patient = describe_patient(segment, args.sex, args.age, args.region, presets_of(args))
     rec["patient"] = patient
     if args.out:
         write_json(args.out, rec)
@@ -393,10 +301,10 @@ def cmd_plot(args):
     from colonsim.files import save_figure
     from colonsim.surrogate.plot import prediction_figure
 
-    model = _load(args)
+    model, strict, _ = load_model(args)
     segment = _segment(args, model)
     vs = VS_NAMES.get(args.vs.lower(), args.vs)
-    query = _patient_query(model, segment, args, _presets(args))
-    fig = prediction_figure(model, segment, vs, query, target=args.target, scopes=args.scope, strict=args.strict)
+    query = patient_query(model, segment, args, presets_of(args))
+    fig = prediction_figure(model, segment, vs, query, target=args.target, scopes=args.scope, strict=strict)
     save_figure(fig, args.out)
     print(f"figure: {args.out}")

@@ -2,7 +2,7 @@
 each defined once: outside them no patient lies, whatever the training domain of a surrogate says.
 """
 
-from colonsim.catalog import SCOPE_DIAMETER_RANGE
+from colonsim.catalog import SCOPE_DIAMETER_RANGE, TISSUE_STIFFNESS
 from colonsim.errors import ColonsimError
 
 # name -> (low, high, what to give)
@@ -15,6 +15,7 @@ INPUT_RANGES = {
     "distal_resistance_N": (0.0, 100.0, "distal resistance in N (5 by default; 0, 5, 10, 20 are the study's levels)"),
     "element_size_mm": (0.5, 20.0, "wall element size in mm (3 by default)"),
     "scope_diameter_mm": (SCOPE_DIAMETER_RANGE[0] * 1e3, SCOPE_DIAMETER_RANGE[1] * 1e3, "scope outer diameter in mm"),
+    TISSUE_STIFFNESS: (0.05, 20.0, "tissue stiffness factor on the reference wall law (1: the reference)"),
 }
 
 

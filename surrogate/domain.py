@@ -13,6 +13,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from colonsim.catalog import TISSUE_STIFFNESS, WALL_C11, WALL_MU0, column_unit
 from colonsim.input_ranges import INPUT_RANGES, check_input_range
 from colonsim.errors import ColonsimError, ColonsimWarning
 from colonsim.surrogate.table import INPUT_OPTIONS, INPUTS
@@ -24,6 +25,8 @@ TOLERANCE = 1e-6
 # (a unit, a typo): the GP's length scales are at most 100 ranges, so there it returns its prior
 # whatever the value, and squared distances of ~1e154 ranges overflow to NaN.
 FAR = 1e4
+# beside every number answered outside the training domain
+EXTRAPOLATED = "[EXTRAPOLATED]"
 
 
 def _is_number(value) -> bool:
@@ -150,6 +153,9 @@ class SegmentDomain:
                  for name, values in query.items()}
         self._check_ranges(query)
         unknown = self._unknown_inputs(query)
+        if unknown and TISSUE_STIFFNESS in self.inputs and set(unknown) <= {WALL_MU0, WALL_C11}:
+            raise ColonsimError(f"segment {self.segment}: this model takes the tissue as its stiffness factor "
+                                f"({TISSUE_STIFFNESS}), not as {', '.join(unknown)}; give --stiffness or --material FILE")
         if unknown:
             options = ", ".join(INPUT_OPTIONS.get(u, u) for u in unknown)
             raise ColonsimError(f"segment {self.segment}: the surrogate was fitted on a table without "
@@ -169,8 +175,11 @@ class SegmentDomain:
                                 "check the value and its unit")
         outside = below | above
         for j in np.flatnonzero(outside.any(axis=0)):  # (the per-input loops cost a query's time)
+            unit = column_unit(self.inputs[j])
             for i in np.flatnonzero(outside[:, j]):
-                reasons[i].append(f"{self.inputs[j]} {X[i, j]:g} outside {self.low[j]:g}-{self.high[j]:g}")
+                by, side = (self.low[j] - X[i, j], "below") if below[i, j] else (X[i, j] - self.high[j], "above")
+                reasons[i].append(f"{self.inputs[j]} {X[i, j]:g} outside {self.low[j]:g}-{self.high[j]:g} "
+                                  f"({by:.3g}{' ' + unit if unit else ''} {side})")
         for name, value in self.fixed.items():
             given = query.get(name)
             if given is None:
@@ -187,7 +196,8 @@ class SegmentDomain:
             message = (f"{self.segment} {where}{text[first]} (outside the training domain; the prediction "
                        "extrapolates)")
             if strict:
-                raise ColonsimError(message.replace("the prediction extrapolates", "drop --strict to extrapolate anyway"))
+                raise ColonsimError(message.replace("the prediction extrapolates", "not extrapolated; drop --strict, or give "
+                                                                                  "--extrapolate, to answer anyway"))
             if warn:
                 extra = f" and {int((~inside).sum()) - 1} more" if (~inside).sum() > 1 else ""
                 warnings.warn(message + extra, OutOfDomainWarning, stacklevel=3)

@@ -24,7 +24,6 @@ from __future__ import annotations
 import numpy as np
 from scipy.linalg import cho_solve, cholesky, solve_triangular
 from scipy.optimize import minimize
-from scipy.stats import qmc
 
 from colonsim.errors import ColonsimError
 from colonsim.surrogate.hyperposterior import DRAWS, Mixture, laplace_draws
@@ -141,6 +140,8 @@ class GaussianProcess:
         n_restarts = restarts_for(n_runs, self.n_restarts)
         if n_restarts:
             low, high = np.log([0.1] + [0.1] * d + [1e-4]), np.log([10.0] + [10.0] * d + [0.1])
+            from scipy.stats import qmc  # on fitting only: scipy.stats costs a query's import a second
+
             sobol = qmc.Sobol(d + 2, seed=self.random_state).random_base2(int(np.ceil(np.log2(n_restarts))))
             starts += list(low + (high - low) * sobol[:n_restarts])
         return starts

@@ -37,7 +37,6 @@ import math
 
 import numba
 import numpy as np
-from scipy.stats import qmc
 
 from colonsim.surrogate.kernel import matern52
 from colonsim.surrogate.likelihood import JITTER, log_marginal_likelihood
@@ -70,6 +69,8 @@ def laplace_draws(theta, bounds, X, y, n_draws=DRAWS, floor=CURVATURE_FLOOR, see
                       - log_marginal_likelihood(theta - step, X, y)[1]) / (2.0 * HESSIAN_STEP)
     precision, vectors = np.linalg.eigh(-0.5 * (hessian + hessian.T))
     cov = vectors @ np.diag(1.0 / np.maximum(precision, floor)) @ vectors.T
+    from scipy.stats import qmc  # on fitting only: scipy.stats costs a query's import a second
+
     draws = qmc.MultivariateNormalQMC(theta, cov, seed=seed).random(n_draws)
     low, high = np.array(bounds, dtype=float).T
     low[1:-1] = np.maximum(low[1:-1], np.log(SHORTEST_LENGTH_SCALE))

@@ -22,11 +22,14 @@ from colonsim.surrogate.larger import LargerOf, cross_validate_larger, identity_
 from colonsim.surrogate.table import (INPUT_OPTIONS, INPUTS, PAIN_PROXY, TARGETS, check_results, numeric_column,
                                       scope_diameter_mm, scope_diameters, solver_settings, split_inputs,
                                       successful_runs)
-from colonsim.surrogate.tissue import TISSUE_INPUTS, TissueDistribution, plan, split_predict, tissue_inputs
+from colonsim.surrogate.tissue import (TISSUE_INPUTS, TissueDistribution, plan, split_predict, tissue_inputs,
+                                       tissue_representation)
 from colonsim.surrogate.validation import Z95, cross_validate, error_unknown
 from colonsim.insertion.study.material_samples import MATERIAL_PARAMETERS
 from colonsim.catalog import LARGER_OF
 
+# the ending of a run whose tip turned back on itself: outside the model, left out of training by default
+TIP_FOLDED = "tip_folded"
 # columns of each target in predict_frame (the 95 % interval is mean +- 1.96 total sd)
 SUFFIXES = ("", "_std", "_low95", "_high95", "_std_tissue", "_std_surrogate")
 
@@ -66,10 +69,14 @@ class SweepSurrogate:
         Draws of each GP's hyperparameters its predictions average over (0: the likelihood's
         maximum alone, a plug-in); None: as many as the runs call for
         (:func:`colonsim.surrogate.gp.draws_for`, :mod:`colonsim.surrogate.hyperposterior`).
+    tip_folded : bool
+        Train on runs that ended with a folded tip too (``ended_by`` :data:`TIP_FOLDED`). Default
+        False: a folded tip is outside the model; such runs are left out and counted (``training_``).
     """
 
     def __init__(self, targets=TARGETS, inputs=INPUTS, segments=None, cv="loo", n_restarts=None, min_runs=4,
-                 random_state=0, threads=1, tissue=None, replicates=None, hyperparameter_draws=None):
+                 random_state=0, threads=1, tissue=None, replicates=None, hyperparameter_draws=None,
+                 tip_folded=False):
         self.targets = targets
         self.inputs = inputs
         self.segments = segments
@@ -81,6 +88,7 @@ class SweepSurrogate:
         self.tissue = tissue
         self.replicates = replicates
         self.hyperparameter_draws = hyperparameter_draws
+        self.tip_folded = tip_folded
 
     def _make_gp(self, domain, noise_floor_sd=0.0):
         return lambda: GaussianProcess(input_range=(domain.low, domain.high), n_restarts=self.n_restarts,
@@ -103,8 +111,16 @@ class SweepSurrogate:
             raise ColonsimError(f"the results table has no column {', '.join(unknown)}; choose targets among its outputs")
         segments = self.segments or [s for s in dict.fromkeys(table["segment"]) if (table["segment"] == s).any()]
         self.domains_, self.models_, self.cv_, self.skipped_, self.notes_, self.scatter_ = {}, {}, {}, {}, [], {}
-        self.training_ = {"runs": int(len(table)), "ok": int((table["status"] == "ok").sum()),
-                          "failed": int((table["status"] != "ok").sum())}
+        self.about_ = None  # what a shipped predictor says of itself (colonsim.surrogate.predictor_fit)
+        folded = ((table["status"] == "ok") & (table["ended_by"] == TIP_FOLDED) if "ended_by" in table.columns
+                  else pd.Series(False, index=table.index))
+        if folded.any() and not self.tip_folded:  # counted in training_, said by report()
+            table = table[~folded].reset_index(drop=True)
+        ok = table["status"] == "ok"
+        commits = sorted(set(table.loc[ok, "git_commit"].dropna().astype(str)) - {""}) if "git_commit" in table else []
+        self.training_ = {"runs": int(len(table)), "ok": int(ok.sum()), "failed": int((~ok).sum()),
+                          "tip_folded": int(folded.sum()), "tip_folded_trained": bool(self.tip_folded),
+                          "git_commits": commits}
         absent = [name for name in self.inputs if name not in table.columns]
         if absent:
             self.notes_.append(f"the table has no column {', '.join(absent)}: the model cannot take "
@@ -116,6 +132,9 @@ class SweepSurrogate:
                 self.notes_.append(f"{segment}: no successful run, no model")
                 continue
             varying, fixed = split_inputs(runs, self.inputs)
+            varying, note = tissue_representation(runs, varying)
+            if note:
+                self.notes_.append(f"{segment}: {note}")
             undefined = [n for n in self.inputs if n in runs.columns and runs[n].isna().all()]
             if undefined:
                 self.notes_.append(f"{segment}: {', '.join(undefined)} undefined (NaN) in every run, not an input")
@@ -319,7 +338,10 @@ class SweepSurrogate:
     # -- description ---------------------------------------------------------------------------------
     def report(self) -> str:
         """Training domain, hyperparameters and cross-validated accuracy, as text."""
-        lines = [f"trained on {self.training_['ok']} successful runs ({self.training_['failed']} failed runs ignored)"]
+        folded = self.training_.get("tip_folded", 0)  # absent in models of before
+        lines = [f"trained on {self.training_['ok']} successful runs ({self.training_['failed']} failed runs ignored"
+                 + (f"; {folded} tip-folded runs {'trained on' if self.training_.get('tip_folded_trained') else 'left out'}"
+                    if folded else "") + ")"]
         for seg, domain in self.domains_.items():
             lines.append(domain.describe())
             for target, gp in self.models_[seg].items():
@@ -344,8 +366,8 @@ class SweepSurrogate:
             for target, why in self.skipped_[seg].items():
                 lines.append(f"  {target:<22} no model: {why}")
         if getattr(self, "tissue_", None) is not None and any(tissue_inputs(d) for d in self.domains_.values()):
-            lines.append(f"tissue: predictions without wall_mu0_kPa / wall_C11_kPa average over "
-                         f"{self.tissue_.description}")
+            given = sorted({c for d in self.domains_.values() for c in tissue_inputs(d)}, key=TISSUE_INPUTS.index)
+            lines.append(f"tissue: predictions without {' / '.join(given)} average over {self.tissue_.description}")
         lines.extend(f"note: {n}" for n in self.notes_)
         if self.domains_:
             scheme = next((self.cv_[s][t].get("scheme") for s in self.models_ for t, gp in self.models_[s].items()

@@ -35,15 +35,22 @@ import numpy as np
 from scipy.special import ndtr
 
 from colonsim.errors import ColonsimError
+from colonsim.surrogate.domain import EXTRAPOLATED
 from colonsim.surrogate.tissue import plan, split_predict, trend_components
 from colonsim.surrogate.table import NAMED_SCOPES_MM, PAIN_PROXY, STANDARD_SCOPE, scope_diameter_mm, target_unit
 from colonsim.surrogate.validation import Z95
 
 
+# more scope diameters than this in a sweep: a design over diameters (a hypercube), not scopes to rank
+GRID_SCOPES = 5
+
+
 def default_scopes(domain):
-    """The named scopes the sweep ran (UTC, PDC, SDC or its own), else the three of docs/model.md."""
+    """The named scopes the sweep ran (UTC, PDC, SDC or its own diameters, up to :data:`GRID_SCOPES`
+    of them), else the three of docs/model.md."""
     named = {k: v for k, v in domain.scopes.items() if k in NAMED_SCOPES_MM}
-    table = named or domain.scopes or NAMED_SCOPES_MM
+    own = domain.scopes if len(domain.scopes) <= GRID_SCOPES else {}
+    table = named or own or NAMED_SCOPES_MM
     return sorted(table, key=lambda name: table[name])  # thinnest first
 
 
@@ -129,14 +136,15 @@ def _mixture_draws(means, covs, n_draws, seed):
 def format_recommendation(rec) -> str:
     """The recommendation as a few lines of text."""
     unit = target_unit(rec["target"])
+    mark = "" if rec["in_domain"] else f"{EXTRAPOLATED} "
     if rec.get("error_unknown"):
-        lines = [f"{rec['segment'].upper()}, {rec['target']}: " + " < ".join(s.upper() for s in rec["ranking"])
+        lines = [f"{mark}{rec['segment'].upper()}, {rec['target']}: " + " < ".join(s.upper() for s in rec["ranking"])
                  + f" by the predicted means; no probability or interval: the model rests on {rec['n_runs']} runs, "
                  f"{rec['error_unknown']}"]
         lines += [f"  {s['rank']}. {s['scope'].upper():>5} ({s['diameter_mm']:g} mm): {s['mean']:.3g} {unit}"
-                  + ("" if s["in_domain"] else f"  OUTSIDE the training domain: {s['domain_note']}") for s in rec["scopes"]]
+                  + ("" if s["in_domain"] else f"  {EXTRAPOLATED} OUTSIDE the training domain: {s['domain_note']}") for s in rec["scopes"]]
         return "\n".join(lines)
-    lines = [f"{rec['segment'].upper()}, {rec['target']}: " + " < ".join(s.upper() for s in rec["ranking"])
+    lines = [f"{mark}{rec['segment'].upper()}, {rec['target']}: " + " < ".join(s.upper() for s in rec["ranking"])
              + f"  (probability this order holds: {100 * rec['p_ranking']:.0f} %; "
              f"{100 * rec['p_ranking_with_cv_error']:.0f} % allowing the surrogate's cross-validated error of "
              f"{rec['cv_rmse']:.2g} {unit} per scope)"]
@@ -146,13 +154,13 @@ def format_recommendation(rec) -> str:
                    f"({100 * s['p_less_than_reference_with_cv_error']:.0f} % with CV error)")
         lines.append(f"  {s['rank']}. {s['scope'].upper():>5} ({s['diameter_mm']:g} mm): {s['mean']:.3g} {unit} "
                      f"[95 % {s['low95']:.3g}, {s['high95']:.3g}]  P(least) {100 * s['p_best']:.0f} %{vs}"
-                     + ("" if s["in_domain"] else f"  OUTSIDE the training domain: {s['domain_note']}"))
+                     + ("" if s["in_domain"] else f"  {EXTRAPOLATED} OUTSIDE the training domain: {s['domain_note']}"))
     tissue = rec["tissue"]
     if not tissue["modelled"]:
         lines.append(f"  uncertainty: surrogate only; {tissue['note']}")
     else:
         split = ", ".join(f"{s['scope'].upper()} tissue {s['std_tissue']:.2g}, surrogate {s['std_surrogate']:.2g}"
                           for s in rec["scopes"])
-        lines.append(f"  uncertainty split (sd, {unit}): {split}; {tissue['note']}")
+        lines.append(f"  {mark}uncertainty split (sd, {unit}): {split}; {tissue['note']}")
     lines.append(f"  ({rec['uncertainty']}; the model rests on {rec['n_runs']} runs)")
     return "\n".join(lines)

@@ -56,8 +56,10 @@ def _sha256(path):
     return hashlib.sha256(Path(path).read_bytes()).hexdigest()
 
 
-def save_surrogate(model: SweepSurrogate, path, source=None):
-    """Write ``model`` as ``<path>.json`` + ``<path>.npz``; returns the two paths."""
+def save_surrogate(model: SweepSurrogate, path, source=None, about=None):
+    """Write ``model`` as ``<path>.json`` + ``<path>.npz``; returns the two paths. ``about``: a
+    JSON-able description stored with it and read back as ``model.about_`` (the shipped
+    predictor's sweeps, engine and domain: :mod:`colonsim.surrogate.predictor_fit`)."""
     json_path, npz_path = model_paths(path)
     arrays, segments = {}, {}
     for seg, domain in model.domains_.items():
@@ -84,12 +86,13 @@ def save_surrogate(model: SweepSurrogate, path, source=None):
     doc = {"format": FORMAT, "format_version": FORMAT_VERSION, "colonsim_version": __version__,
            "git_commit": code_version()["git_commit"],
            "created": datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds"),
-           "source": None if source is None else str(source),
+           "source": None if source is None else str(source), "about": about,
            "arrays": {"file": npz_path.name, "sha256": None},
            "estimator": {"targets": list(model.targets), "inputs": list(model.inputs),
                          "segments": None if model.segments is None else list(model.segments), "cv": model.cv,
                          "n_restarts": model.n_restarts, "min_runs": model.min_runs, "random_state": model.random_state,
-                         "threads": model.threads, "hyperparameter_draws": model.hyperparameter_draws},
+                         "threads": model.threads, "hyperparameter_draws": model.hyperparameter_draws,
+                         "tip_folded": model.tip_folded},
            "training": model.training_, "notes": model.notes_, "segments": segments,
            "tissue": None if model.tissue_ is None else model.tissue_.to_dict()}
     bad = next((k for k, a in arrays.items() if a.dtype.kind == "f" and not np.isfinite(a).all()), None)
@@ -140,8 +143,10 @@ def _read_pair(doc, json_path, npz_path) -> SweepSurrogate:
         model = SweepSurrogate(targets=tuple(est["targets"]), inputs=tuple(est["inputs"]), segments=est["segments"],
                                cv=est["cv"], n_restarts=est["n_restarts"], min_runs=est["min_runs"],
                                random_state=est["random_state"], threads=est.get("threads", 1),
-                               hyperparameter_draws=est.get("hyperparameter_draws"))
+                               hyperparameter_draws=est.get("hyperparameter_draws"),
+                               tip_folded=bool(est.get("tip_folded", False)))
         model.training_, model.notes_ = doc["training"], list(doc["notes"])
+        model.about_ = doc.get("about")
         model.tissue_ = TissueDistribution.from_dict(doc.get("tissue"))  # files of format 1.0 hold none
         model.domains_, model.models_, model.cv_, model.skipped_, model.scatter_ = {}, {}, {}, {}, {}
         with np.load(npz_path, allow_pickle=False) as arrays:

@@ -1,7 +1,9 @@
 """The tissue's share of a prediction's spread: the law of total variance over the wall material.
 
-A surrogate fitted on a sweep whose wall material varied has the material's small-strain shear
-modulus and C11 among its inputs (:data:`TISSUE_INPUTS`). A patient's tissue is not known: it is a
+A surrogate fitted on a sweep whose wall material varied has the tissue among its inputs
+(:data:`TISSUE_INPUTS`): as the tissue stiffness factor when every run's wall is one law scaled
+(:mod:`colonsim.insertion.study.tissue_stiffness`; the patient-space sweep), else as the material's
+small-strain shear modulus and C11 (:func:`tissue_representation`). A patient's tissue is not known: it is a
 draw ``t`` from a tissue distribution (by default the one the sweep sampled, stored with the
 surrogate; or a user's own calibration). For a query ``x`` the prediction averages over it::
 
@@ -25,15 +27,17 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
-from colonsim.catalog import WALL_C11, WALL_MU0
+from colonsim.catalog import TISSUE_STIFFNESS, WALL_C11, WALL_MU0
 from colonsim.errors import ColonsimError
 from colonsim.inputs import check_input
 from colonsim.surrogate.domain import OutOfDomainWarning
+from colonsim.insertion.case.case_material import case_material
 from colonsim.insertion.engine.material import read_material_document
 from colonsim.insertion.study.material_samples import (MATERIAL_PARAMETERS, Posterior, read_population,
                                                        read_posterior, tissue_columns)
 
-TISSUE_INPUTS = (WALL_MU0, WALL_C11)
+TISSUE_INPUTS = (WALL_MU0, WALL_C11, TISSUE_STIFFNESS)
+SCALED = 1e-6  # relative spread of mu0 / stiffness (and C11 / stiffness) below which the walls are one law scaled
 DRAWS, SEED = 1000, 0
 # More than this share of the draws outside the runs' tissue range: a warning. With N materials
 # drawn in the sweep and two tissue inputs, about 1 - (1 - 2 / (N + 1))^2 of new draws fall outside
@@ -57,12 +61,19 @@ class TissueDistribution:
 
     @classmethod
     def from_file(cls, path):
-        """A calibration's ``material.json`` (its posterior) or a ``population.json`` (its specimens)."""
+        """A calibration's ``material.json`` (its posterior), a ``population.json`` (its specimens),
+        or a material that states no uncertainty (its parameters alone: no tissue part)."""
         path = check_input(path, "material file")
-        if "specimens" in read_material_document(path):
+        doc = read_material_document(path)
+        if "specimens" in doc:
             pop = read_population(path)
             return cls("empirical", str(path), f"the {len(pop.values)} specimens of {path.name} ({pop.law})",
                        points=tissue_columns(pop.law, pop.values))
+        if doc.get("covariance_Pa2") is None:
+            material = case_material(str(path))
+            return cls("empirical", str(path), f"the material of {path.name} ({material.law}; the file states no "
+                                               "parameter uncertainty, so no tissue part)",
+                       points=tissue_columns(material.law, [material.parameters]))
         post = read_posterior(path)
         return cls("posterior", str(path), f"the posterior of {path.name} ({post.law}, normal truncated to "
                                            "non-negative parameters)", posterior=post)
@@ -120,6 +131,24 @@ class TissueDistribution:
         points = {k: np.array([np.nan if v is None else v for v in vals], dtype=float)
                   for k, vals in doc["points_kPa"].items()}
         return cls("empirical", doc["source"], doc["description"], points=points)
+
+
+def tissue_representation(runs: pd.DataFrame, varying: list):
+    """The model's inputs ``varying`` with one representation of the tissue, and a note (or None).
+
+    When every run's wall is one law scaled (mu0 and C11 in a fixed ratio to the stiffness factor),
+    the stiffness factor stands for the three; otherwise mu0 and C11 do, and the stiffness factor,
+    which follows from them, is left out."""
+    if TISSUE_STIFFNESS not in varying:
+        return varying, None
+    moduli = [c for c in (WALL_MU0, WALL_C11) if c in varying]
+    stiffness = runs[TISSUE_STIFFNESS].to_numpy(dtype=float)
+    ratios = [runs[c].to_numpy(dtype=float) / stiffness for c in moduli]
+    if all(np.ptp(r) <= SCALED * np.max(np.abs(r)) for r in ratios):
+        note = (f"{', '.join(moduli)} follow {TISSUE_STIFFNESS} in every run (the walls are one law scaled): the "
+                "stiffness factor stands for them" if moduli else None)
+        return [c for c in varying if c not in moduli], note
+    return [c for c in varying if c != TISSUE_STIFFNESS], None
 
 
 def tissue_inputs(domain) -> list:
@@ -188,8 +217,10 @@ def plan(domain, query: dict, n: int, distribution: TissueDistribution | None, s
     filled = dict(query)
     for c, k in zip(columns, j):  # the domain check of the other inputs sees a tissue inside the range
         filled[c] = np.where(full, given[:, columns.index(c)], 0.5 * (domain.low[k] + domain.high[k]))
-    note = (f"averaged over {len(draws)} {'draws' if distribution.kind == 'posterior' else 'materials'} of "
-            f"{distribution.description}" + (f"; {100 * outside:.0f} % of them outside the runs' tissue range "
+    what = (f"tissue: {distribution.description}" if len(draws) == 1 else
+            f"averaged over {len(draws)} {'draws' if distribution.kind == 'posterior' else 'materials'} of "
+            f"{distribution.description}")
+    note = (what + (f"; {100 * outside:.0f} % of them outside the runs' tissue range "
                                                "(extrapolated)" if outside > 0 else ""))
     return filled, TissuePlan(columns, full, draws, note, outside)
 

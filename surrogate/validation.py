@@ -18,7 +18,7 @@ The interval is that of a new simulation result (trend + scatter), the quantity 
 from __future__ import annotations
 
 import numpy as np
-from scipy.stats import chi2
+from scipy.special import chdtri
 
 from colonsim.errors import ColonsimError
 from colonsim.surrogate.likelihood import inverse_from_cholesky
@@ -88,7 +88,7 @@ def error_unknown(cv: dict, gp) -> str | None:
     if n < needed:
         return (f"too few runs to know its error ({n} < {MIN_RUNS_PER_INPUT} per input, "
                 f"{needed} for its {inputs}); fit more runs")
-    limit = float(np.sqrt(chi2.ppf(0.95, n) / n))
+    limit = float(np.sqrt(chdtri(n, 0.05) / n))  # the chi-square's 95th percentile
     if z_rms > limit:
         return (f"too few runs to know its error: its cross-validated errors are {z_rms:.1f} times the sd it states "
                 f"(at most {limit:.2f} with {n} runs)")

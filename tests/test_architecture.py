@@ -41,6 +41,7 @@ LAYERS = {
     "colonsim.identification.joint": WORKFLOW, "colonsim.identification.joint_report": WORKFLOW,
     "colonsim.surrogate": WORKFLOW,
     "colonsim.workflows": TOP, "colonsim.cli": TOP, "colonsim.cli_sweep": TOP, "colonsim.cli_surrogate": TOP,
+    "colonsim.cli_queries": TOP,
     "colonsim.options": TOP, "colonsim.demo": TOP, "colonsim.cli_material": TOP, "colonsim.calibrate_modes": TOP,
 }
 LAYER_NAMES = ("ground", "physics", "anatomy", "case", "workflow", "top")

@@ -133,7 +133,8 @@ def test_failed_runs_and_nan_targets_are_left_out():
     table = synthetic_sweep(n_runs=12, segments=("rsj",), n_failed=3, seed=4)
     table.loc[5, "final_deformation_cm"] = np.nan  # one ok run without this output
     m = SweepSurrogate(targets=("final_deformation_cm", "max_deformation_cm"), n_restarts=0).fit(table)
-    assert m.training_ == {"runs": 12, "ok": 9, "failed": 3}
+    assert m.training_ == {"runs": 12, "ok": 9, "failed": 3, "tip_folded": 0, "tip_folded_trained": False,
+                           "git_commits": []}
     assert m.cv_["rsj"]["final_deformation_cm"]["n"] == 8 and m.cv_["rsj"]["max_deformation_cm"]["n"] == 9
 
 

@@ -49,6 +49,7 @@ from colonsim.inputs import check_input
 from colonsim.laws import OgdenLaw, get_wall_law
 from colonsim.insertion.case.case_material import case_material
 from colonsim.insertion.engine.material import REFERENCE_MATERIAL_PATH, read_material_document
+from colonsim.insertion.study.tissue_stiffness import STIFFNESS, stiffness_factor
 
 SECTION_KEYS = ("file", "population", "samples", "seed")
 MATERIAL_PARAMETERS = "material_parameters"  # the InsertionCase field a draw sets
@@ -150,7 +151,8 @@ def read_population(path) -> Population:
 
 def tissue_columns(law: str, values) -> dict:
     """The surrogate's tissue inputs of parameter rows ``values`` (n, p) in Pa of ``law``: mu0 and
-    C11 in kPa (C11 NaN for a law without it, Ogden's included)."""
+    C11 in kPa (C11 NaN for a law without it, Ogden's included) and the stiffness factor on the
+    reference law (:mod:`colonsim.insertion.study.tissue_stiffness`)."""
     model = get_wall_law(law)
     p = np.atleast_2d(np.asarray(values, dtype=float))
     if isinstance(model, OgdenLaw):
@@ -161,7 +163,7 @@ def tissue_columns(law: str, values) -> dict:
         mu0 = 2.0 * (np.asarray(d[1]) + np.asarray(d[2])) / 1e3
     names = model.parameter_names
     c11 = p[:, names.index("C11")] / 1e3 if "C11" in names else np.full(len(p), np.nan)
-    return {WALL_MU0: mu0, WALL_C11: c11}
+    return {WALL_MU0: mu0, WALL_C11: c11, STIFFNESS: stiffness_factor(law, p)}
 
 
 def material_columns(case) -> dict:
@@ -191,7 +193,7 @@ def _tissue_values(path, parameters_text) -> dict:
     try:
         material = case_material(path, json.loads(parameters_text) if parameters_text else None)
     except ColonsimError:  # a failed run of a material that no longer reads: no values, not an error
-        return {WALL_MU0: math.nan, WALL_C11: math.nan}
+        return {WALL_MU0: math.nan, WALL_C11: math.nan, STIFFNESS: math.nan}
     return {k: float(v[0]) for k, v in tissue_columns(material.law, [material.parameters]).items()}
 
 

@@ -2,11 +2,68 @@
 :mod:`colonsim.insertion.study.sweep_spec` reads, one entry per preset.
 """
 
+import dataclasses
+import math
+
 from colonsim.catalog import SMOKE_ELEMENT_MM, SMOKE_PUSH_SPEED, SMOKE_SCOPE_SPACING_MM
 from colonsim.insertion.case.insertion_case import InsertionCase
 
 # The rate check's push speed: half the default (docs/model.md, "Time integration and damping").
 HALF_SPEED = 0.5 * InsertionCase.push_speed
+
+# The patient space of the shipped predictor (colonsim.surrogate.predictor): per patient model its
+# inputs' ranges, a Latin hypercube of 12 runs per input to fit on (the surrogate states no error
+# below 10 per input: colonsim.surrogate.validation.MIN_RUNS_PER_INPUT; the margin is for runs left
+# out), an independent one of 30 to hold out, and 10 cases run at two wall meshes (3 and 2.8 mm, 7 %
+# finer) whose pairs measure the runs' own scatter. The angle is RSF's alpha and THF's beta (RSJ has
+# none); the colon diameter of RSJ spans the source's 23 and 36 mm, that of RSF and THF (36 mm
+# assumed) a range around it; the stiffness factor scales the reference wall law
+# (colonsim.insertion.study.tissue_stiffness) and covers the bundled specimens (0.76-1.27) with their
+# scatter (lognormal sd 0.15: 3 sd is 0.64-1.57).
+PATIENT_RANGES = {
+    "scope_diameter_mm": (9.0, 13.5), "diameter_mm": (20.0, 40.0), "angle_deg": (0.0, 60.0), "friction": (0.0, 0.1),
+    "distal_resistance_N": (0.0, 20.0), "stiffness_factor": (0.6, 1.6),
+}
+PATIENT_MODELS = {  # model -> (inputs it varies, its own ranges, training runs, seed)
+    "rsj": (("scope_diameter_mm", "diameter_mm", "friction", "distal_resistance_N", "stiffness_factor"), {}, 60, 1),
+    "rsf": (("scope_diameter_mm", "angle_deg", "diameter_mm", "friction", "distal_resistance_N", "stiffness_factor"),
+            {"diameter_mm": (25.0, 40.0)}, 72, 2),
+    "thf": (("scope_diameter_mm", "angle_deg", "diameter_mm", "friction", "distal_resistance_N", "stiffness_factor"),
+            {"diameter_mm": (25.0, 40.0)}, 72, 3),
+}
+# the other parts of each model's sweep: runs and seed offset (added to the training seed)
+PATIENT_PARTS = {"heldout": (30, 100), "replicates": (10, 200)}
+REPLICATE_MESHES_MM = (3.0, 2.8)
+
+
+def patient_space(model: str, part: str = "") -> str:
+    """The TOML of the patient-space sweep of ``model``: its training runs (``part`` ""), its
+    held-out runs ("heldout") or its replicate pairs ("replicates").
+
+    The held-out and replicate hypercubes span each range less one training stratum (range /
+    training runs) at either end: a Latin hypercube puts a training run in each end stratum, so
+    every such run lies inside the training runs' box, where the predictor answers without
+    extrapolating."""
+    inputs, own, runs, seed = PATIENT_MODELS[model]
+    ranges = {name: own.get(name, PATIENT_RANGES[name]) for name in inputs}
+    grid = [f'segment = "{model}"']
+    what = "training runs of the shipped predictor"
+    if part:
+        ranges = {n: (math.ceil(1e3 * (lo + (hi - lo) / runs)) / 1e3, math.floor(1e3 * (hi - (hi - lo) / runs)) / 1e3)
+                  for n, (lo, hi) in ranges.items()}  # rounded inwards, to the hypercube's 3 decimals
+        runs, offset = PATIENT_PARTS[part]
+        seed += offset
+        what = "held-out runs (never fitted on)" if part == "heldout" else (
+            f"cases each run at wall meshes of {' and '.join(f'{m:g}' for m in REPLICATE_MESHES_MM)} mm (the runs' "
+            "own scatter)")
+        if part == "replicates":
+            grid.append(f"element_size_mm = [{', '.join(f'{m:g}' for m in REPLICATE_MESHES_MM)}]")
+    name = f"patient_space_{model}" + (f"_{part}" if part else "")
+    lines = ["[sweep]", f'name = "{name}"', f"seed = {seed}",
+             f'description = "Patient space of {model.upper()}: {runs} {what}, a Latin hypercube over '
+             f'{", ".join(inputs)}"', "", "[[grid]]", *grid, "", "[lhs]", f"samples = {runs}"]
+    lines += [f"{n} = [{round(lo, 3):g}, {round(hi, 3):g}]" for n, (lo, hi) in ranges.items()]
+    return "\n".join(lines) + "\n"
 
 PRESETS = {
     # The source's Chapter V: RSJ D23/D36 x 3 scopes x mu 0/0.05/0.1 (18 runs); RSF alpha and THF
@@ -137,3 +194,8 @@ scope = ["utc", "sdc"]
 friction = [0.05]
 """,
 }
+# Offered once the case takes a stiffness factor (InsertionCase.stiffness_factor, which scales the
+# parameters of its wall law): without it no run of these sweeps could be made.
+if "stiffness_factor" in {f.name for f in dataclasses.fields(InsertionCase)}:
+    PRESETS.update({f"patient_space_{m}" + (f"_{part}" if part else ""): patient_space(m, part)
+                    for m in PATIENT_MODELS for part in ("", *PATIENT_PARTS)})

@@ -19,8 +19,10 @@ OUTPUTS = catalog.columns(catalog.OUTPUT)
 
 
 def input_columns() -> list:
-    """Every InsertionCase field (from the dataclass), the derived scope diameter and wall moduli."""
-    return [f.name for f in dataclasses.fields(InsertionCase)] + ["scope_diameter_mm", catalog.WALL_MU0, catalog.WALL_C11]
+    """Every InsertionCase field (from the dataclass), the derived scope diameter, wall moduli and
+    tissue stiffness."""
+    return [f.name for f in dataclasses.fields(InsertionCase)] + ["scope_diameter_mm", catalog.WALL_MU0, catalog.WALL_C11,
+                                                                  catalog.TISSUE_STIFFNESS]
 
 
 # each field with what its column holds when the field is None: a column keeps one type, "" for
@@ -35,7 +37,7 @@ def input_row(case) -> dict:
         value = getattr(case, name)
         row[name] = absent if value is None else value
     row["scope_diameter_mm"] = round(colonoscope(case.scope).diameter * 1e3, 6)  # 11.3, not 11.299999999999999
-    row.update(material_columns(case))  # drawn parameters as JSON text, mu0 and C11 in kPa
+    row.update(material_columns(case))  # drawn parameters as JSON text, mu0 and C11 in kPa, stiffness
     return row
 
 
