@@ -340,6 +340,8 @@ COLUMNS = {c.name: c for c in (
            SURROGATE_INPUT, "wall shear modulus mu0 [kPa]", "--wall-mu0"),
     Column(WALL_C11, _I, "kPa", "C11 of the run's wall material (NaN for a law without a C11 term)", SURROGATE_INPUT,
            "wall C11 [kPa]", "--wall-c11"),
+    Column("stiffness_factor", _I, "", "factor on every parameter in Pa of the run's wall material (1: the material "
+                                      "as given); the surrogate sees the wall through tissue_stiffness"),
     Column(TISSUE_STIFFNESS, _I, "", "the run's wall material as a factor on the reference wall law (1: the reference; "
                                      "colonsim.insertion.study.tissue_stiffness)", SURROGATE_INPUT,
            "tissue stiffness factor", "--stiffness"),

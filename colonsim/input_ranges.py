@@ -16,6 +16,7 @@ INPUT_RANGES = {
     "element_size_mm": (0.5, 20.0, "wall element size in mm (3 by default)"),
     "scope_diameter_mm": (SCOPE_DIAMETER_RANGE[0] * 1e3, SCOPE_DIAMETER_RANGE[1] * 1e3, "scope outer diameter in mm"),
     TISSUE_STIFFNESS: (0.05, 20.0, "tissue stiffness factor on the reference wall law (1: the reference)"),
+    "stiffness_factor": (0.05, 20.0, "factor on the wall material's parameters in Pa (1: the material as given)"),
 }
 
 

@@ -26,10 +26,7 @@ from colonsim.surrogate.tissue import (TISSUE_INPUTS, TissueDistribution, plan, 
                                        tissue_representation)
 from colonsim.surrogate.validation import Z95, cross_validate, error_unknown
 from colonsim.insertion.study.material_samples import MATERIAL_PARAMETERS
-from colonsim.catalog import LARGER_OF
-
-# the ending of a run whose tip turned back on itself: outside the model, left out of training by default
-TIP_FOLDED = "tip_folded"
+from colonsim.catalog import LARGER_OF, TIP_FOLDED
 # columns of each target in predict_frame (the 95 % interval is mean +- 1.96 total sd)
 SUFFIXES = ("", "_std", "_low95", "_high95", "_std_tissue", "_std_surrogate")
 

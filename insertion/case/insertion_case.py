@@ -29,7 +29,7 @@ TIME_STEP_ESTIMATES = ("bounds", "global")
 # fields left out of the key at the value that gives the runs of before they existed
 # (a default changed to another value then gives new keys: no run of before is taken for one of it)
 ABSENT_AT = {"distal_resistance_N": 0.0, "held_push_share": 1.0, "held_push_lead_mm": 0.0, "relax_max_s": 0.0,
-             "time_step_estimate": "bounds", "contact_surface": "nodes"}
+             "time_step_estimate": "bounds", "contact_surface": "nodes", "stiffness_factor": 1.0}
 
 
 @dataclass
@@ -131,6 +131,10 @@ class InsertionCase:
     material_parameters : dict or None
         {name: Pa} replacing the parameters of ``material`` (its law stays); set by a sweep's
         ``[material]`` section (:mod:`colonsim.insertion.study.material_samples`). None = the file's.
+    stiffness_factor : float
+        Every parameter in Pa of the wall law (the file's or the drawn ones) times this factor: the
+        wall's stress at every stretch scaled by it (1: the material as given; the patient-space
+        sweeps vary it, :mod:`colonsim.insertion.study.tissue_stiffness`).
     """
 
     segment: str = "rsj"
@@ -166,6 +170,7 @@ class InsertionCase:
     record_interval_s: float = 1e-3
     time_step_factor: float = 0.9
     material_parameters: dict | None = None
+    stiffness_factor: float = 1.0
     time_step_estimate: str = "global"
     contact_surface: str = "nodes"
     contact_face_subdivision: int = 2
@@ -180,7 +185,7 @@ class InsertionCase:
             raise ColonsimError(f"a centerline file is given for segment {self.segment!r}, which has its own shape; "
                                 "use segment 'patient' (--centerline implies it) or drop the centerline")
         for name in ("diameter_mm", "wall_thickness_mm", "element_size_mm", "exit_length_mm", "flexure_angle_deg",
-                     "friction", "distal_resistance_N"):  # the ranges every command shares
+                     "friction", "distal_resistance_N", "stiffness_factor"):  # the ranges every command shares
             check_input_range(name, getattr(self, name))
         checks = [
             ("scope_spacing_mm", self.scope_spacing_mm, 1.0, 50.0,
@@ -228,8 +233,8 @@ class InsertionCase:
         if self.element_size_mm > self.diameter_mm / 3:
             raise ColonsimError(f"element size {self.element_size_mm} mm is too coarse for a {self.diameter_mm} mm colon; "
                                 "use at most a third of the diameter")
-        if self.material_parameters is not None:
-            case_material(self.material, self.material_parameters)
+        if self.material_parameters is not None or self.stiffness_factor != 1.0:
+            case_material(self.material, self.material_parameters, self.stiffness_factor)
         scope = colonoscope(self.scope)
         if self.centerline is None:
             scope.check_fits(self.diameter_mm * 1e-3)

@@ -130,7 +130,7 @@ def build_insertion(case: InsertionCase) -> Insertion:
     case.validate()
     anatomy = colon_model(case.segment)
     geometry = insertion_geometry(case)
-    material = case_material(case.material, case.material_parameters)
+    material = case_material(case.material, case.material_parameters, case.stiffness_factor)
     shell = Shell(geometry.nodes, geometry.triangles, case.wall_thickness_mm * 1e-3, material,
                   density=COLON_DENSITY, name="colon")
 

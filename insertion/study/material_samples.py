@@ -169,29 +169,30 @@ def tissue_columns(law: str, values) -> dict:
 def material_columns(case) -> dict:
     """The material columns of ``case``'s results row: its drawn parameters as JSON text ("" for
     none) and its material's mu0 and C11 in kPa (NaN if its material cannot be read)."""
-    params = case.material_parameters
+    params, factor = case.material_parameters, case.stiffness_factor
     text = "" if params is None else json.dumps(params)
     path = Path(case.material or REFERENCE_MATERIAL_PATH).absolute()
     try:
         stat = path.stat()
     except OSError:  # read as before: the material's own error, taken as "cannot be read" below
-        return {MATERIAL_PARAMETERS: text, **_tissue_values(case.material, text)}
-    return {MATERIAL_PARAMETERS: text, **_tissue_values_of_file(str(path), stat.st_mtime_ns, stat.st_size, text)}
+        return {MATERIAL_PARAMETERS: text, **_tissue_values(case.material, text, factor)}
+    return {MATERIAL_PARAMETERS: text,
+            **_tissue_values_of_file(str(path), stat.st_mtime_ns, stat.st_size, text, factor)}
 
 
 @lru_cache(maxsize=256)
-def _tissue_values_of_file(path, mtime_ns, size, parameters_text):
-    """:func:`_tissue_values`, cached per material file state (path, modification time, size) and
-    drawn parameters: the adaptive sweep reads the columns of about a thousand candidates a round,
-    which all share one or a few materials."""
-    return _tissue_values(path, parameters_text)
+def _tissue_values_of_file(path, mtime_ns, size, parameters_text, factor):
+    """:func:`_tissue_values`, cached per material file state (path, modification time, size),
+    drawn parameters and stiffness factor: the adaptive sweep reads the columns of about a
+    thousand candidates a round, which all share one or a few materials."""
+    return _tissue_values(path, parameters_text, factor)
 
 
-def _tissue_values(path, parameters_text) -> dict:
-    """mu0 and C11 (kPa) of the material at ``path`` with the drawn parameters given as JSON text
-    ("" for none); NaN if it cannot be read."""
+def _tissue_values(path, parameters_text, factor) -> dict:
+    """mu0 and C11 (kPa) and the stiffness factor of the material at ``path`` with the drawn
+    parameters given as JSON text ("" for none), scaled by ``factor``; NaN if it cannot be read."""
     try:
-        material = case_material(path, json.loads(parameters_text) if parameters_text else None)
+        material = case_material(path, json.loads(parameters_text) if parameters_text else None, factor)
     except ColonsimError:  # a failed run of a material that no longer reads: no values, not an error
         return {WALL_MU0: math.nan, WALL_C11: math.nan, STIFFNESS: math.nan}
     return {k: float(v[0]) for k, v in tissue_columns(material.law, [material.parameters]).items()}

@@ -2,7 +2,6 @@
 :mod:`colonsim.insertion.study.sweep_spec` reads, one entry per preset.
 """
 
-import dataclasses
 import math
 
 from colonsim.catalog import SMOKE_ELEMENT_MM, SMOKE_PUSH_SPEED, SMOKE_SCOPE_SPACING_MM
@@ -194,8 +193,5 @@ scope = ["utc", "sdc"]
 friction = [0.05]
 """,
 }
-# Offered once the case takes a stiffness factor (InsertionCase.stiffness_factor, which scales the
-# parameters of its wall law): without it no run of these sweeps could be made.
-if "stiffness_factor" in {f.name for f in dataclasses.fields(InsertionCase)}:
-    PRESETS.update({f"patient_space_{m}" + (f"_{part}" if part else ""): patient_space(m, part)
-                    for m in PATIENT_MODELS for part in ("", *PATIENT_PARTS)})
+PRESETS.update({f"patient_space_{m}" + (f"_{part}" if part else ""): patient_space(m, part)
+                for m in PATIENT_MODELS for part in ("", *PATIENT_PARTS)})
