@@ -292,7 +292,8 @@ def _drops_cell(r):
 def _rate_cell(r):
     if r["rate"] is None:
         return "-"
-    failed = [f"{c.replace('_cm', '').replace('_N', '')} {100 * v['change']:+.1f} %"
+    failed = [f"{c.replace('_cm', '').replace('_N', '')} " + ("count differs" if v["change"] is None else
+                                                               f"{100 * v['change']:+.1f} %")
               for c, v in r["rate"]["changes"].items() if v["passed"] is False]
     return {True: "passes", None: "-"}.get(r["rate"]["passed"], "NO: " + ", ".join(failed))
 

@@ -88,7 +88,7 @@ def rest_summary(ts, hold_start) -> dict:
                         f"last {REST_WINDOW:g} s of the closing hold",
            "came_to_rest": False, "held_s": 0.0, "deformation_drift_mm": None, "tip_drift_mm": None}
     if hold_start is None or ts["time_s"].iloc[-1] < hold_start:
-        return {**out, "meaning": "no closing hold: the run ended under its load (a jam or a tear) or without one"}
+        return {**out, "meaning": "no closing hold: the run ended under its load (a jam, a fold or a tear) or without one"}
     hold = ts[ts["time_s"] >= hold_start - 1e-12]
     out["held_s"] = float(ts["time_s"].iloc[-1] - hold_start)
     drift = rest_drift(hold["time_s"], hold["deformation_m"], hold["tip_displacement_m"])
