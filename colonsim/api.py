@@ -5,16 +5,16 @@ re-exports these names lazily, so importing the package stays cheap. Every funct
 inputs as the command line does (a bad input raises :class:`colonsim.ColonsimError` with one line
 naming the problem and the fix) and writes its files into one folder, replaced whole when done.
 
-=================  ===========================================  ==========================
-function           what it does                                 command line
-=================  ===========================================  ==========================
-:func:`calibrate`  fit a tissue law to strip tensile curves     ``colonsim calibrate``
-:func:`insert`     push scopes through a colon model            ``colonsim insert``
-:func:`sweep`      run a sweep of insertions, resumable         ``colonsim sweep``
-:func:`fit_surrogate`  fit Gaussian processes on a sweep table  ``colonsim surrogate fit``
-:func:`predict`    predict outputs with their uncertainty       ``colonsim predict``
-:func:`recommend`  rank the scopes for a patient                ``colonsim recommend``
-=================  ===========================================  ==========================
+=======================  ============================================  ============================
+function                 what it does                                  command line
+=======================  ============================================  ============================
+:func:`calibrate`        fit a tissue law to strip tensile curves      ``colonsim calibrate``
+:func:`insert`           push scopes through a colon model             ``colonsim insert``
+:func:`sweep`            run a sweep of insertions, resumable          ``colonsim sweep``
+:func:`fit_surrogate`    fit Gaussian processes on a sweep table       ``colonsim surrogate fit``
+:func:`predict`          predict outputs with their uncertainty        ``colonsim predict``
+:func:`recommend`        rank the scopes for a patient                 ``colonsim recommend``
+=======================  ============================================  ============================
 
 The examples run as tests (``tests/test_api.py``) at the smoke size of
 :mod:`colonsim.catalog`: coarse meshes and a fast push, whose numbers are not results.
