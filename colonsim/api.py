@@ -78,7 +78,9 @@ def insert(segment="rsj", scope="sdc", *, out="colonsim_results/insertion", cent
     ``element_size_mm``, ...; the reference's "Model parameters" lists them). A run at the defaults
     takes minutes.
 
-    Returns each run's summary (the dict written as ``summary.json``).
+    Returns each run's :class:`~colonsim.insertion.case.scenario.InsertionResult`: ``summary`` (the
+    dict written as ``summary.json``), ``timeseries`` (the DataFrame written as ``timeseries.csv``),
+    ``final_shape`` (wall and scope node positions at the end, m), ``case`` and ``model``.
 
     Example (a straight tube at the smoke size, seconds once the solver is compiled):
 
@@ -88,8 +90,8 @@ def insert(segment="rsj", scope="sdc", *, out="colonsim_results/insertion", cent
     ...                        scope_spacing_mm=SMOKE_SCOPE_SPACING_MM, push_speed=SMOKE_PUSH_SPEED,
     ...                        out="straight_smoke")  # doctest: +ELLIPSIS
     STRAIGHT SDC: ...
-    >>> len(runs), runs[0]["final_deformation_cm"] >= 0
-    (1, True)
+    >>> len(runs), runs[0].summary["final_deformation_cm"] >= 0, "push_force_N" in runs[0].timeseries
+    (1, True, True)
     """
     from colonsim.insertion.case.insertion_case import InsertionCase
     from colonsim.workflows import anatomy_inputs, insert as run
@@ -105,7 +107,7 @@ def insert(segment="rsj", scope="sdc", *, out="colonsim_results/insertion", cent
         cases = [InsertionCase(**anatomy, scope=str(s), **inputs) for s in scopes]
     except TypeError as error:  # an unknown keyword
         raise ColonsimError(f"{error}; the inputs are InsertionCase's fields (docs: reference, model parameters)")
-    return [r.summary for r in run(cases, Path(out), vtu=vtu, show=show_progress)]
+    return run(cases, Path(out), vtu=vtu, show=show_progress)
 
 
 def sweep(spec=None, *, preset=None, out=None, workers=1, retry_failed=False, show_progress=False):
