@@ -98,7 +98,13 @@ def _field_docs(cls) -> dict:
             lines = []
         elif names and line.strip():
             lines.append(line.strip())
-    return found
+    return {name: _plain(text) for name, text in found.items()}
+
+
+def _plain(text) -> str:
+    """Docstring markup as plain text: ``x`` and :role:`~a.b.x` become x, **x** stays x."""
+    text = re.sub(r":[a-z]+:`~?([^`]+)`", r"\1", text)
+    return text.replace("``", "").replace("**", "")
 
 
 def _text(value) -> str:
