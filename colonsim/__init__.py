@@ -1,10 +1,30 @@
 """colonsim: how much a colonoscope deforms the colon.
 
-The command line lives in :mod:`colonsim.cli`; the workflows are the packages
-:mod:`identification` (tissue calibration) and :mod:`insertion` (explicit insertion solver).
+The workflows as functions: :func:`calibrate`, :func:`insert`, :func:`sweep`,
+:func:`fit_surrogate`, :func:`predict`, :func:`recommend` (defined in :mod:`colonsim.api`). The
+command line lives in :mod:`colonsim.cli`; the physics in the subpackages
+:mod:`colonsim.identification` (tissue calibration), :mod:`colonsim.insertion` (explicit
+insertion solver) and :mod:`colonsim.surrogate` (Gaussian-process surrogate).
 """
 
 from colonsim.errors import ColonsimError
 
-__all__ = ["ColonsimError"]
 __version__ = "0.1.0"
+
+# The public API is re-exported lazily (PEP 562): ``import colonsim`` stays cheap and loads no
+# module of a higher layer; the first use of ``colonsim.insert`` imports colonsim.api
+# (docs/architecture.md, "Layers").
+_API = ("calibrate", "insert", "sweep", "fit_surrogate", "predict", "recommend", "load_surrogate")
+__all__ = ["ColonsimError", *_API]
+
+
+def __getattr__(name):
+    if name in _API:
+        from colonsim import api
+
+        return getattr(api, name)
+    raise AttributeError(f"module 'colonsim' has no attribute {name!r}")
+
+
+def __dir__():
+    return sorted(set(globals()) | set(_API))
