@@ -62,6 +62,7 @@ PARAMETERS = {
     "record_interval_s": ("s", NUMERICAL),
     "time_step_factor": ("", NUMERICAL),
     "material_parameters": ("Pa", INPUT),
+    "stiffness_factor": ("", INPUT),
     "time_step_estimate": ("", NUMERICAL),
     "contact_surface": ("", NUMERICAL),
     "contact_face_subdivision": ("", NUMERICAL),
