@@ -28,7 +28,7 @@ import pandas as pd
 CASES = {
     "rsj": {"segment": "rsj", "scope": "13.3", "diameter_mm": 36.0},
     "thf": {"segment": "thf", "scope": "13.3", "angle_deg": 45.0},
-    # the resisted RSF whose settled end the push speed moved (docs/model.md, "Every run ends at rest")
+    # the resisted RSF whose settled end the push speed moved (docs/notes/2026-11-model-studies.md, "Every run ends at rest")
     "rsf_10N": {"segment": "rsf", "scope": "13.3", "angle_deg": 45.0, "distal_resistance_N": 10.0},
     "rsf_10N_mu01": {"segment": "rsf", "scope": "13.3", "angle_deg": 45.0, "distal_resistance_N": 10.0,
                      "friction": 0.1},

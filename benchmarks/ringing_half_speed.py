@@ -1,7 +1,7 @@
 """Write the sweep of a resistance sweep's runs that ring above the limit, at half the push speed.
 
 The validation report judges each run of the ``resistance`` preset whose ringing ratio is above
-the limit by the proposed bound (docs/model.md, "Ringing that no push speed removes"): the same
+the limit by the proposed bound (docs/notes/2026-11-model-studies.md, "Ringing that no push speed removes"): the same
 run at half the push speed. Which runs ring depends on the engine that made the sweep, so the list
 is written from the sweep's own table rather than kept by hand::
 

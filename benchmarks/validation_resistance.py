@@ -11,7 +11,7 @@ speed) of one case per model. Runs missing from the table are listed, never fill
 The runs that ring above the limit are listed with what their ringing is made of and, given a sweep
 of the same runs at half the push speed (``benchmarks/sweeps/ringing_half_speed.toml``, written
 from the resistance sweep by ``benchmarks/ringing_half_speed.py``, passed as
-``--ringing-half-sweep DIR``), with the proposed bound's verdict (docs/model.md, "Ringing that no
+``--ringing-half-sweep DIR``), with the proposed bound's verdict (docs/notes/2026-11-model-studies.md, "Ringing that no
 push speed removes"): half the speed lowers the ratio by less than :data:`BOUND_RATIO_FALL` and
 the rate pair passes.
 """
@@ -36,7 +36,7 @@ from validation_sweeps import role, scope_label
 LEVELS_N = (0.0, 5.0, 10.0, 20.0)
 SHAPES_LEVEL_N = 10.0  # the level whose final shapes the section draws (the issue's "typical")
 # The proposed bound for a run above the ringing limit (not applied by the program): half the push
-# speed lowers its ratio by less than this share, and its rate pair passes (docs/model.md, "Ringing
+# speed lowers its ratio by less than this share, and its rate pair passes (docs/notes/2026-11-model-studies.md, "Ringing
 # that no push speed removes"). A ringing that inertia makes falls with the speed (its forces go as
 # the speed's square); one that stays or grows at half the speed is the mesh's or the path's.
 BOUND_RATIO_FALL = 0.20
@@ -274,7 +274,7 @@ def _remainder_lines(remainder) -> list:
                  f"{num(r['half_ratio'])} ({100 * r['ratio_change']:+.0f} %)"),
                 ("rate pair", _rate_cell),
                 ("bound", lambda r: {True: "holds", False: "NO", None: "-"}[r["bound"]])]
-    return [intro + "; and the proposed bound (docs/model.md, \"Ringing that no push speed removes\"): the same "
+    return [intro + "; and the proposed bound (docs/notes/2026-11-model-studies.md, \"Ringing that no push speed removes\"): the same "
             f"run at half the push speed rings at least {100 * (1 - BOUND_RATIO_FALL):.0f} % as much (inertia's ringing "
             "would fall), and its rate pair passes (5 % on the deformations, 10 % on the peak forces; the failing "
             "columns are named):", "", md_table(remainder["above"], columns), "",

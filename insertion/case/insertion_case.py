@@ -24,7 +24,7 @@ from colonsim.insertion.engine.contact_points import FACE_SUBDIVISIONS, WALL_SAM
 
 # cases that do not use them stay what they were (existing sweep folders resume).
 LATER_FIELDS = ("centerline", "centerline_smoothing_mm", "material_parameters", "failure_stretch")
-# how the stable time step is estimated (docs/model.md, "The global time-step estimate")
+# how the stable time step is estimated (docs/notes/2026-11-model-studies.md, "The global time-step estimate")
 TIME_STEP_ESTIMATES = ("bounds", "global")
 # fields left out of the key at the value that gives the runs of before they existed
 # (a default changed to another value then gives new keys: no run of before is taken for one of it)
@@ -77,7 +77,7 @@ class InsertionCase:
         Wall triangle size and scope node spacing.
     push_speed : float
         Plateau push speed, m/s (0.15: a quarter of the source's 0.6; the loops behind a held
-        tip that failed the rate check at 0.3 agree between 0.15 and 0.075; docs/model.md, "The
+        tip that failed the rate check at 0.3 agree between 0.15 and 0.075; docs/notes/2026-11-model-studies.md, "The
         default push speed halved").
     held_push_share : float
         Once the distal resistance holds the tip, the push goes on at this share of
@@ -86,7 +86,7 @@ class InsertionCase:
     held_push_lead_mm : float
         The held push begins when the tip is this far (along the centerline, mm) before the fixed
         exit, so the tip meets the resistance already slowed (50; 0: when the resistance engages;
-        docs/model.md, "The push speed at which the tip meets the resistance" and "The defaults of
+        docs/notes/2026-11-model-studies.md, "The push speed at which the tip meets the resistance" and "The defaults of
         2026-11-28").
     sheath_reserve_mm : float
         Scope length that stays in the sheath at the end of the push (**assumption** 20).

@@ -25,7 +25,7 @@ from colonsim.errors import ColonsimError
 
 DEFAULT_MAX_STEPS = 2_000_000  # 20-70 x a default run (28,000-99,000 steps, thesis sweep); ~15 min on one core
 # Wall time of one solver step on one core, a + b * (nodes not held at the start: the scope's and
-# the free wall's; a held wall costs next to nothing, docs/model.md "Cost"), fitted to the 39 runs
+# the free wall's; a held wall costs next to nothing, docs/notes/2026-11-model-studies.md "Cost"), fitted to the 39 runs
 # of the thesis sweep (2026-11-25, 2 workers on an idle 2-core machine, one Numba thread each):
 # within 22 % for every run, 0.20 ms/step at 101 such nodes (fixed THF) to 0.62 at 4141 (THF);
 # the count of all nodes was off by up to 135 %. Machines differ (the same runs have taken up to
