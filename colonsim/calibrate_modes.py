@@ -116,7 +116,7 @@ def _describe(r) -> str:
     for _, row in r.per_curve.iterrows():
         r2 = "-" if row["r2"] is None else f"{row['r2']:.4f}"
         lines.append(f"  {row['curve']:<24} {row['mode']:<11} weight {row['weight']:g}: R^2 {r2}, RMS {row['rms_Pa'] / 1e3:.4g} kPa "
-                     f"({row['n_points']} points, to stretch {row['max_stretch']:.3g})")
+                     f"= {row['rms_over_noise']:.1f} x noise ({row['n_points']} points, to stretch {row['max_stretch']:.3g})")
     lo, hi = r.stability.stretch_range
     lines.append(f"  Drucker stability over stretch {lo:.3g}-{hi:.3g} in {', '.join(r.stability.onsets)}: "
                  f"{'stable' if r.stability.is_stable else 'UNSTABLE'}")
@@ -167,9 +167,9 @@ def calibrate_modes(request: ModeRequest, out: Path) -> list:
         ordered = [chosen]
     print(_describe(chosen))
     for r in ordered:
-        warning = r.stability.warning()
-        if warning:
-            print(f"colonsim: warning: {warning}", file=sys.stderr, flush=True)
+        for warning in [*r.warnings, r.stability.warning()]:
+            if warning:
+                print(f"colonsim: warning: {warning}", file=sys.stderr, flush=True)
     print(f"results: {written['material']} (+ fit.csv, curves.csv, history.csv, modes.png"
           f"{', laws.csv, laws.png, laws/' if request.compare_laws else ''} in {out}/)")
     return ordered

@@ -213,7 +213,7 @@ def check_manifest_columns(columns, path, required, optional):
     columns = [c.strip() for c in columns]
     missing = [c for c in required if c not in columns]
     if missing:
-        raise ColonsimError(f"{path}: a manifest needs the column(s) {', '.join(missing)} ({','.join(required)})")
+        raise ColonsimError(f"{path}: manifest lacks the column(s) {', '.join(missing)}; expected {','.join(required)}")
     known = (*required, *optional)
     for column in columns:
         if column not in known:
