@@ -71,7 +71,7 @@ def _clean(curves, request, out):
     import numpy as np
 
     from colonsim.files import save_figure
-    from colonsim.identification.cleanup import clean_curves, figure
+    from colonsim.identification.cleanup import check_decimation, clean_curves, figure
     from colonsim.identification.stress_curves import from_strip
 
     load_start = request.load_start * 1e-3 if isinstance(request.load_start, (int, float)) else request.load_start
@@ -83,6 +83,7 @@ def _clean(curves, request, out):
         if c.strip is not None:
             out_curves.append(from_strip(by_name[c.name], c.weight))
         elif request.decimate is not None:
+            check_decimation(c.name, request.decimate, c.stretch.size)
             grid = np.linspace(c.stretch[0], c.max_stretch, request.decimate)
             step = {"step": "decimation", "points_before": int(c.stretch.size), "points_after": request.decimate,
                     "how": "linear interpolation at evenly spaced stretches"}

@@ -7,7 +7,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from colonsim.identification.cards import DENSITY, FORMATS
-from colonsim.options import finite_float, output_folder
+from colonsim.options import finite_float, output_folder, ranged
 
 
 def add_calibrate_options(parser):
@@ -27,8 +27,9 @@ def add_calibrate_options(parser):
     c.add_argument("--load-start", type=_load_start, default=None, metavar="detect|off|MM",
                    help="where the load starts: detect (slack or preload found in the data), off (raw curve), or the "
                         "displacement in mm; default: a slack region found is corrected and said so, a preload only reported")
-    c.add_argument("--decimate", type=int, default=None, metavar="N",
-                   help="resample every curve at N evenly spaced displacements (stretches) before fitting")
+    c.add_argument("--decimate", type=ranged("--decimate"), default=None, metavar="N",
+                   help="resample every curve at N evenly spaced displacements (stretches) before fitting (5 to the "
+                        "curve's own points)")
     parser.add_argument("--export", nargs="+", choices=FORMATS, metavar="FORMAT",
                         help=f"also write the fitted law as material cards: {', '.join(FORMATS)} (material_<format>.* in --out)")
 
