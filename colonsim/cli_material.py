@@ -64,16 +64,13 @@ def _law_and_parameters(path):
     from colonsim.errors import ColonsimError
     from colonsim.identification.hyperelastic import calibration_law
     from colonsim.insertion.engine.material import read_material_document
+    from colonsim.schemas import check_material_document
 
     doc = read_material_document(path)
     law = doc.get("law")
     if not isinstance(law, str):
         raise ColonsimError(f"material file {path} has no law; pass a material.json of colonsim calibrate")
-    names = calibration_law(law).parameter_names
-    params = doc.get("parameters")
-    if not isinstance(params, dict) or any(n not in params for n in names) or doc.get("units", "Pa") != "Pa":
-        raise ColonsimError(f"material file {path} lacks the parameters {', '.join(names)} in Pa; regenerate it")
-    return law, params
+    return law, check_material_document(doc, path, calibration_law(law).parameter_names)
 
 
 def cmd_material_export(args):

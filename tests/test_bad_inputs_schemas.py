@@ -127,3 +127,20 @@ def test_a_material_document_with_nan_or_a_missing_parameter_is_refused():
                           ({"C10": 1e4, "C01": 2e3}, "parameter C11 is None")):
         with pytest.raises(ColonsimError, match=match):
             check_material_document({**good, "parameters": params}, "m.json", ("C10", "C01", "C11"))
+
+
+def test_material_export_refuses_a_material_file_with_nan_and_writes_nothing(tmp_path, capsys):
+    from colonsim.cli import main
+    from colonsim.data import REFERENCE_MATERIAL_PATH
+
+    doc = json.loads(REFERENCE_MATERIAL_PATH.read_text())
+    name = next(iter(doc["parameters"]))
+    edited = tmp_path / "material.json"
+    edited.write_text(json.dumps({**doc, "parameters": {**doc["parameters"], name: float("nan")}}))
+    before = digest(tmp_path)
+    assert main(["material", "export", str(edited), "--format", "lsdyna"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and f"parameter {name} is nan, not a finite number" in err[0]
+    assert digest(tmp_path) == before
+    edited.write_text(json.dumps(doc))
+    assert main(["material", "export", str(edited), "--format", "lsdyna"]) == 0
