@@ -135,11 +135,11 @@ def check_results_table(frame, name, types, key_of=None):
                             f"recorded twice); {RESULTS_RECOVERY}")
     if key_of is not None:
         for row in frame.to_dict("records"):
-            _check_key(row, name, key_of, [c for c in types if c not in frame.columns], unknown)
+            _check_key(row, name, key_of, [c for c in types if c not in frame.columns])
     return frame
 
 
-def _check_key(row, name, key_of, absent, unknown):
+def _check_key(row, name, key_of, absent):
     try:
         key = key_of(row)
     except ColonsimError as exc:
@@ -157,9 +157,8 @@ def _check_key(row, name, key_of, absent, unknown):
         hints.append(f"empty input(s) {', '.join(empty[:4])}")
     inputs_absent = [c for c in absent if catalog.COLUMNS.get(c) is not None
                      and catalog.COLUMNS[c].kind in (catalog.INPUT, catalog.SETTING)]
-    if inputs_absent and unknown:
-        hints.append(f"input column(s) {', '.join(inputs_absent[:4])} missing, unknown column(s) "
-                     f"{', '.join(unknown[:4])}")
+    if inputs_absent:
+        hints.append(f"input column(s) {', '.join(inputs_absent[:4])} missing, read as their defaults")
     why = f" ({'; '.join(hints)})" if hints else " (an input or the key was edited)"
     raise ColonsimError(f"{name}: the key of run {row['key']} is not the hash of its inputs{why}; {RESULTS_RECOVERY}")
 

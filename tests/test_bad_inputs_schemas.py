@@ -79,7 +79,8 @@ def test_an_older_table_without_a_later_column_still_resumes(tmp_path):
                                                                         r"writes and friction is missing"),
     (lambda t: t.__setitem__("friction", t["friction"].astype(str)), r"column friction holds str values \('0.1'\) "
                                                                      r"where the sweep writes numbers"),
-    (lambda t: t.drop(columns=["friction"]), r"the key of run \w+ is not the hash of its inputs"),
+    (lambda t: t.drop(columns=["friction"]), r"the key of run \w+ is not the hash of its inputs \(input column\(s\) "
+                                              r"friction missing, read as their defaults\)"),
     (lambda t: t.__setitem__("diameter_mm", [30.0, 36.0]), r"the key of run \w+ is not the hash of its inputs"),
     (lambda t: t.__setitem__("friction", [float("nan"), 0.1]), r"\(empty input\(s\) friction\)"),
     (lambda t: t.__setitem__("key", ["0123456789ab", t["key"][1]]), r"key of run 0123456789ab is not the hash"),

@@ -13,7 +13,11 @@ that were in flight; failed runs are recorded with their error (rerun them with
 ``retry_failed=True``) and never stop the others. ``reuse`` takes the finished runs of the same
 cases (the same key: every input equal) from other sweep folders instead of running them again;
 their rows keep the code version that made them. A folder holds one sweep: another sweep (other
-cases) written into it is refused, so that one table never mixes two sweeps.
+cases) written into it is refused, so that one table never mixes two sweeps. A table, a
+``sweep.json`` or a finished run's folder that is not as the sweep wrote it (a column renamed,
+dropped or turned into text, a key or an input edited, a run folder deleted) is refused before
+any run starts, with nothing written (:mod:`colonsim.schemas`,
+:mod:`colonsim.insertion.study.sweep_table`); so is a folder named by ``reuse`` whose table is.
 
 Runs go to a local process pool or an existing Dask distributed cluster
 (:mod:`colonsim.insertion.study.sweep_outcomes`); both yield outcomes as runs finish, and only this process writes files:
