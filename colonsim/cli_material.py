@@ -7,7 +7,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from colonsim.identification.cards import DENSITY, FORMATS
-from colonsim.options import finite_float, output_folder, ranged
+from colonsim.options import StretchRange, finite_float, output_folder, ranged
 
 
 def add_calibrate_options(parser):
@@ -20,7 +20,7 @@ def add_calibrate_options(parser):
     g.add_argument("--residuals", choices=("relative", "absolute"), default="relative",
                    help="joint-fit residuals per curve: relative (default; floor 10%% of the curve's peak) or "
                         "absolute in units of the curve's peak")
-    g.add_argument("--stability-range", type=finite_float, nargs=2, metavar=("LOW", "HIGH"),
+    g.add_argument("--stability-range", type=finite_float, nargs=2, metavar=("LOW", "HIGH"), action=StretchRange,
                    help="stretches over which a multi-mode fit's laws are checked for Drucker stability "
                         "(default 0.5 to twice the largest tested stretch; a strip fit always checks that default)")
     c = parser.add_argument_group("clean-up (recorded in material.json)")

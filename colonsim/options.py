@@ -74,6 +74,17 @@ def ranged(option):
     return value_type
 
 
+class StretchRange(argparse.Action):
+    """``LOW HIGH`` stretches (``nargs=2``, finite numbers): from below 1 to above 1, checked when
+    parsed, whether or not the run uses them."""
+
+    def __call__(self, parser, namespace, values, option_string=None):
+        low, high = values
+        if not 0 < low < 1 < high:
+            parser.error(f"argument {option_string}: {low:g} {high:g} must run from below 1 to above 1 (e.g. 0.5 4)")
+        setattr(namespace, self.dest, (low, high))
+
+
 def worker_count(text) -> int:
     """Local worker processes: 1 to :func:`colonsim.limits.max_workers` (a few per core)."""
     value = positive_int(text)

@@ -58,3 +58,12 @@ def test_a_million_queries_are_read_and_a_larger_file_than_the_bound_is_refused(
         fh.truncate(QUERY_MAX_BYTES + 1)
     with pytest.raises(ColonsimError, match=r"query file .*huge.csv holds 32 MB, more than the 32 MB an input may hold"):
         read_query_file(huge)
+
+
+def test_a_stability_range_is_checked_when_parsed_even_for_a_strip_fit_that_does_not_use_it(capsys, tmp_path):
+    from colonsim.data import BUNDLED_MANIFEST
+
+    argv = ["calibrate", "--manifest", str(BUNDLED_MANIFEST), "--stability-range", "2", "4", "--out", str(tmp_path / "o")]
+    assert main(argv) == 2
+    one_line_error(capsys, "--stability-range", "2 4 must run from below 1 to above 1")
+    assert not (tmp_path / "o").exists()
