@@ -71,7 +71,7 @@ def _clean(curves, request, out):
     import numpy as np
 
     from colonsim.files import save_figure
-    from colonsim.identification.cleanup import clean_curves, figure
+    from colonsim.identification.cleanup import check_decimation, clean_curves, figure
     from colonsim.identification.stress_curves import from_strip
 
     load_start = request.load_start * 1e-3 if isinstance(request.load_start, (int, float)) else request.load_start
@@ -83,6 +83,7 @@ def _clean(curves, request, out):
         if c.strip is not None:
             out_curves.append(from_strip(by_name[c.name], c.weight))
         elif request.decimate is not None:
+            check_decimation(c.name, request.decimate, c.stretch.size)
             grid = np.linspace(c.stretch[0], c.max_stretch, request.decimate)
             step = {"step": "decimation", "points_before": int(c.stretch.size), "points_after": request.decimate,
                     "how": "linear interpolation at evenly spaced stretches"}
@@ -116,7 +117,7 @@ def _describe(r) -> str:
     for _, row in r.per_curve.iterrows():
         r2 = "-" if row["r2"] is None else f"{row['r2']:.4f}"
         lines.append(f"  {row['curve']:<24} {row['mode']:<11} weight {row['weight']:g}: R^2 {r2}, RMS {row['rms_Pa'] / 1e3:.4g} kPa "
-                     f"({row['n_points']} points, to stretch {row['max_stretch']:.3g})")
+                     f"= {row['rms_over_noise']:.1f} x noise ({row['n_points']} points, to stretch {row['max_stretch']:.3g})")
     lo, hi = r.stability.stretch_range
     lines.append(f"  Drucker stability over stretch {lo:.3g}-{hi:.3g} in {', '.join(r.stability.onsets)}: "
                  f"{'stable' if r.stability.is_stable else 'UNSTABLE'}")
@@ -168,9 +169,9 @@ def calibrate_modes(request: ModeRequest, out: Path) -> list:
         ordered = [chosen]
     print(_describe(chosen))
     for r in ordered:
-        warning = r.stability.warning()
-        if warning:
-            print(f"colonsim: warning: {warning}", file=sys.stderr, flush=True)
+        for warning in [*r.warnings, r.stability.warning()]:
+            if warning:
+                print(f"colonsim: warning: {warning}", file=sys.stderr, flush=True)
     print(f"results: {written['material']} (+ fit.csv, curves.csv, history.csv, modes.png"
           f"{', laws.csv, laws.png, laws/' if request.compare_laws else ''} in {out}/)")
     return ordered

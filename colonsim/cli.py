@@ -157,7 +157,8 @@ def _add_insert(sub):
                    help="N the colon beyond the model opposes to the tip's advance once it is in the fixed exit "
                         "(default 5, the light level of 0/5/10/20; 0: none; docs/model.md, \"Loading\")")
     p.add_argument("--vtu", action="store_true", help="write deformed meshes for ParaView (needs meshio)")
-    p.add_argument("--snapshot-every", type=finite_float, default=0.02, help="simulated seconds between VTU snapshots")
+    p.add_argument("--snapshot-every", type=options.ranged("--snapshot-every"), default=0.02,
+                   help="simulated seconds between VTU snapshots (0.001-10, with --vtu)")
     p.add_argument("--threads", type=int, default=None,
                    help="Numba threads (default: all cores). Use 1 when running several insertions side by side: "
                         "oversubscribed threads slow the kernels down by an order of magnitude")
@@ -178,9 +179,6 @@ def cmd_insert(args):
         from colonsim.insertion.case.results import check_vtu_writer
 
         check_vtu_writer()
-        if not 1e-3 <= args.snapshot_every <= 10.0:  # a snapshot per time step would fill memory and disk
-            raise ColonsimError(f"--snapshot-every {args.snapshot_every:g} s is outside 0.001-10 s; give the "
-                                "simulated seconds between VTU snapshots (default 0.02)")
     if args.threads is not None:
         if not 1 <= args.threads <= numba.config.NUMBA_NUM_THREADS:
             raise ColonsimError(f"--threads {args.threads} must lie in 1-{numba.config.NUMBA_NUM_THREADS} (the cores Numba sees)")

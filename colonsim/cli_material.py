@@ -11,7 +11,7 @@ from colonsim.identification.card_options import (BULK_RATIO_DEFAULT, BULK_RATIO
                                                   MATERIAL_ID_RANGE, check_bulk_ratio, check_density, check_material_id,
                                                   check_poisson, poisson_from_bulk_ratio)
 from colonsim.identification.cards import FORMATS, SUFFIX
-from colonsim.options import finite_float, output_folder
+from colonsim.options import StretchRange, finite_float, output_folder, ranged
 
 
 def add_calibrate_options(parser):
@@ -24,15 +24,16 @@ def add_calibrate_options(parser):
     g.add_argument("--residuals", choices=("relative", "absolute"), default="relative",
                    help="joint-fit residuals per curve: relative (default; floor 10%% of the curve's peak) or "
                         "absolute in units of the curve's peak")
-    g.add_argument("--stability-range", type=finite_float, nargs=2, metavar=("LOW", "HIGH"),
+    g.add_argument("--stability-range", type=finite_float, nargs=2, metavar=("LOW", "HIGH"), action=StretchRange,
                    help="stretches over which a multi-mode fit's laws are checked for Drucker stability "
                         "(default 0.5 to twice the largest tested stretch; a strip fit always checks that default)")
     c = parser.add_argument_group("clean-up (recorded in material.json)")
     c.add_argument("--load-start", type=_load_start, default=None, metavar="detect|off|MM",
                    help="where the load starts: detect (slack or preload found in the data), off (raw curve), or the "
                         "displacement in mm; default: a slack region found is corrected and said so, a preload only reported")
-    c.add_argument("--decimate", type=int, default=None, metavar="N",
-                   help="resample every curve at N evenly spaced displacements (stretches) before fitting")
+    c.add_argument("--decimate", type=ranged("--decimate"), default=None, metavar="N",
+                   help="resample every curve at N evenly spaced displacements (stretches) before fitting (5 to the "
+                        "curve's own points)")
     cards = parser.add_argument_group("material cards (docs/cards.md; the options below go with --export)")
     cards.add_argument("--export", nargs="+", choices=FORMATS, metavar="FORMAT",
                        help=f"also write the fitted law as material cards: {', '.join(FORMATS)} (material_<format>.* in --out)")

@@ -59,22 +59,16 @@ def patient_query(model, segment, args, presets):
 
 def query_frame(args, model):
     """One row per query: from --csv (options fill its missing columns) or from the options, one per scope."""
-    import io
-
     import numpy as np
     import pandas as pd
 
-    from colonsim.inputs import read_input_text
     from colonsim.surrogate.patients import patient_inputs
     from colonsim.surrogate.recommend import default_scopes
+    from colonsim.surrogate.table import read_query_file
 
     presets = presets_of(args)
     if args.csv:
-        text = read_input_text(args.csv, "query file")
-        try:
-            frame = pd.read_csv(io.StringIO(text))
-        except (pd.errors.ParserError, pd.errors.EmptyDataError, UnicodeDecodeError) as exc:
-            raise ColonsimError(f"cannot read {args.csv}: {str(exc).splitlines()[0]}") from None
+        frame = read_query_file(args.csv)
         if args.segment:
             frame = frame.assign(segment=frame["segment"].fillna(args.segment) if "segment" in frame else args.segment)
         elif "segment" not in frame and len(model.domains_) == 1:

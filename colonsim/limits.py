@@ -16,8 +16,13 @@ from colonsim.errors import ColonsimError
 # A testing-machine export or a centerline CSV: an hour of a 1 kHz recording is ~100 MB of text;
 # reading a file costs about 20 times its size in memory, so this keeps a read under ~1.3 GB.
 TEXT_FILE_MAX_BYTES = 64 * 2**20
-# A TOML sweep, a JSON material, presets or tissue file, a query CSV: hand-written documents.
+# A TOML sweep, a JSON material, presets or tissue file: hand-written documents.
 DOCUMENT_MAX_BYTES = 16 * 2**20
+# A query CSV of `colonsim predict --csv`: one patient a row, 13-21 bytes a row. Its cost is the
+# prediction's, not the read's: 100,000 queries (1.3 MB) took 38 s and 460 MB (measured: scope,
+# age and sex columns, one RSJ model of 30 runs, one core), about 2 KB a query; 32 MB holds
+# 1.5-2.5 million queries, minutes and a few GB; a million (21 MB) is accepted.
+QUERY_MAX_BYTES = 32 * 2**20
 # A results table (Parquet or CSV) a surrogate is fitted on, and a surrogate's arrays (.npz):
 # 20,000 runs (the largest sweep) take a few MB; this leaves room for hand-made tables.
 TABLE_MAX_BYTES = 512 * 2**20
@@ -38,6 +43,19 @@ POINTS_RANGE = (5, 200)
 # arithmetic finite (1e-300 mm underflows the strain); the reader's own checks say more about
 # values inside them (a thickness typed in metres, a strip wider than long).
 GEOMETRY_RANGES_MM = {"length": (1e-2, 1e4), "width": (1e-3, 1e4), "thickness": (1e-4, 1e3)}
+
+# -- option values ------------------------------------------------------------------------------
+# Numbers given on the command line whose range is not a physical input's (those are
+# colonsim.input_ranges and InsertionCase.validate): (low, high, what the value is and why the
+# bounds). Each is checked where the option is parsed (colonsim.options.ranged), whether or not
+# the run uses it.
+OPTION_RANGES = {
+    # a snapshot per time step would fill memory and disk; one per 10 s is none in a run of seconds
+    "--snapshot-every": (1e-3, 10.0, "simulated seconds between VTU snapshots"),
+    # fewer points do not fix a law's curvature; more than a curve holds would invent points by
+    # interpolation (checked per curve: colonsim.identification.cleanup.check_decimation)
+    "--decimate": (5, 10_000, "points per curve, at most the curve's own"),
+}
 
 # -- processes ----------------------------------------------------------------------------------
 # Local worker processes: each loads the solver (~300 MB); more than a few per core only costs memory.

@@ -14,7 +14,7 @@ import math
 from colonsim import catalog
 from colonsim.errors import ColonsimError
 from colonsim.files import check_output_file, check_output_folder
-from colonsim.limits import SEED_RANGE, WORKERS_PER_CORE, max_workers
+from colonsim.limits import OPTION_RANGES, SEED_RANGE, WORKERS_PER_CORE, max_workers
 
 
 def finite_float(text) -> float:
@@ -56,6 +56,33 @@ def _whole(text) -> int:
         return int(text)
     except ValueError:
         raise argparse.ArgumentTypeError(f"{text!r} is not a whole number") from None
+
+
+def ranged(option):
+    """A type for the number ``option`` takes, in its range of :data:`colonsim.limits.OPTION_RANGES`
+    (a whole number when both bounds are)."""
+    low, high, what = OPTION_RANGES[option]
+    whole = isinstance(low, int) and isinstance(high, int)
+
+    def value_type(text):
+        value = _whole(text) if whole else finite_float(text)
+        if not low <= value <= high:
+            raise argparse.ArgumentTypeError(f"{value:g} is outside {low:,g}-{high:,g} ({what})")
+        return value
+
+    value_type.__name__ = "whole number" if whole else "number"
+    return value_type
+
+
+class StretchRange(argparse.Action):
+    """``LOW HIGH`` stretches (``nargs=2``, finite numbers): from below 1 to above 1, checked when
+    parsed, whether or not the run uses them."""
+
+    def __call__(self, parser, namespace, values, option_string=None):
+        low, high = values
+        if not 0 < low < 1 < high:
+            parser.error(f"argument {option_string}: {low:g} {high:g} must run from below 1 to above 1 (e.g. 0.5 4)")
+        setattr(namespace, self.dest, (low, high))
 
 
 def worker_count(text) -> int:

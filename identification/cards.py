@@ -33,6 +33,7 @@ from colonsim.identification.card_options import CardOptions
 from colonsim.identification.card_writers import WRITERS
 from colonsim.identification.hyperelastic import CALIBRATION_LAWS, calibration_law
 from colonsim.insertion.engine.material import read_material_document
+from colonsim.schemas import check_material_document
 
 LSDYNA_MIN_POISSON = 0.49  # *MAT_077's manual: smaller values may not work
 
@@ -105,15 +106,7 @@ def read_material(path):
     law = doc.get("law")
     if not isinstance(law, str):
         raise ColonsimError(f"material file {path} has no law; pass a material.json of colonsim calibrate")
-    names = calibration_law(law).parameter_names
-    params = doc.get("parameters")
-    if not isinstance(params, dict) or any(n not in params for n in names) or doc.get("units", "Pa") != "Pa":
-        raise ColonsimError(f"material file {path} lacks the parameters {', '.join(names)} in Pa; regenerate it")
-    bad = [n for n in names if isinstance(params[n], bool) or not isinstance(params[n], (int, float))]
-    if bad:
-        raise ColonsimError(f"material file {path}: parameter {bad[0]} is {params[bad[0]]!r}, not a number; "
-                            "regenerate it")
-    return law, {n: float(params[n]) for n in names}
+    return law, check_material_document(doc, path, calibration_law(law).parameter_names)
 
 
 def _same(a, b) -> bool:

@@ -94,10 +94,19 @@ def shift_load_start(curve: TensileCurve, d0, how) -> TensileCurve:
                    meta={**curve.meta, "cleaning": [*curve.meta.get("cleaning", []), step]})
 
 
-def decimate(curve: TensileCurve, n) -> TensileCurve:
-    """``curve`` resampled at ``n`` evenly spaced displacements over its range."""
+def check_decimation(name, n, points):
+    """Refuse resampling a curve of ``points`` points at ``n``: fewer than 5, or more than it holds
+    (the extra points would be invented by interpolation)."""
     if n < 5:
         raise ColonsimError(f"--decimate {n}: keep at least 5 points")
+    if n > points:
+        raise ColonsimError(f"--decimate {n} is more than the {points} points of {name}: the extra points would be "
+                            f"invented by interpolation; give at most {points}")
+
+
+def decimate(curve: TensileCurve, n) -> TensileCurve:
+    """``curve`` resampled at ``n`` evenly spaced displacements over its range."""
+    check_decimation(curve.name, n, curve.displacement.size)
     grid = np.linspace(curve.displacement[0], curve.max_displacement, int(n))
     step = {"step": "decimation", "points_before": int(curve.displacement.size), "points_after": int(n),
             "how": "linear interpolation at evenly spaced displacements"}

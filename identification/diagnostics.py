@@ -54,14 +54,22 @@ def fit_against_noise(curve, points, residuals, n_parameters) -> dict:
     ``noise_rms_expected_N`` is the RMS a law that follows the curve leaves on average (the
     noise at the interpolated points, less the p degrees of freedom the fit absorbs).
     """
-    sd = noise_sd(curve.displacement, curve.force)
-    n = len(residuals)
-    expected = sd * float(np.sqrt(np.mean(interpolation_variance(curve.displacement, points)) * max(n - n_parameters, 1) / n))
-    rms = float(np.sqrt(np.mean(np.square(residuals))))
-    ratio = rms / expected if expected > 0 else float("inf")
+    sd, expected, ratio = residual_against_noise(curve.displacement, curve.force, points, residuals, n_parameters)
     return {"noise_sd_N": sd, "noise_rms_expected_N": expected, "rms_over_noise": ratio,
-            "follows_curve": bool(ratio <= FOLLOWS_LIMIT),
-            "noise_method": "pseudo-residuals of neighbouring samples (Gasser et al. 1986), independent noise assumed"}
+            "follows_curve": bool(ratio <= FOLLOWS_LIMIT), "noise_method": NOISE_METHOD}
+
+
+NOISE_METHOD = "pseudo-residuals of neighbouring samples (Gasser et al. 1986), independent noise assumed"
+
+
+def residual_against_noise(x, y, points, residuals, n_parameters) -> tuple[float, float, float]:
+    """(noise sd of one sample of the curve ``y(x)``, the RMS a law that follows it leaves at
+    ``points``, the residuals' RMS over that): the measure of :func:`fit_against_noise`."""
+    sd = noise_sd(x, y)
+    n = len(residuals)
+    expected = sd * float(np.sqrt(np.mean(interpolation_variance(x, points)) * max(n - n_parameters, 1) / n))
+    rms = float(np.sqrt(np.mean(np.square(residuals))))
+    return sd, expected, rms / expected if expected > 0 else float("inf")
 
 
 def shear_modulus_weights(law, n_parameters) -> np.ndarray:

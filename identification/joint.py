@@ -16,6 +16,12 @@ On Treloar's three modes the relative default lets both Ogden (3 terms) and Yeoh
 uniaxial and planar curves to R^2 >= 0.99; with absolute residuals Yeoh's uniaxial R^2 drops to
 0.989 (docs/calibration.md has the numbers).
 
+Before the fit, a curve whose values cannot be what its header says (a stretch beyond any tissue
+or rubber test, tension as negative stress, no load) is refused; after it, every curve gets the
+single-curve path's diagnostics (its residual against its own noise, R^2) and a curve the law
+does not follow is named in a warning with the likely cause
+(:mod:`colonsim.identification.curve_checks`).
+
 The search is the project's (:mod:`colonsim.identification.search`: Latin hypercube, CMA-ES,
 Nelder-Mead) with :meth:`Budget.closed_form`, followed by a bounded trust-region least-squares
 polish (scipy ``least_squares``) from the Nelder-Mead optimum and from the 10 best hypercube
@@ -47,6 +53,7 @@ import pandas as pd
 from scipy import optimize
 
 from colonsim.errors import ColonsimError
+from colonsim.identification.curve_checks import check_plausible, curve_misfit, misfit_warnings
 from colonsim.identification.hyperelastic import CalibrationLaw, calibration_law, mode_stretches
 from colonsim.identification.search import Budget, SearchProblem, search
 from colonsim.identification.specimen import ClampedStripModel, FEConvergenceError
@@ -118,6 +125,8 @@ class JointObjective:
         self.curves, self.residuals, self.strip_model = list(curves), residuals, strip_model
         if not self.curves:
             raise ColonsimError("no curves to fit")
+        for c in self.curves:  # before any fitting: values that cannot be what the header says
+            check_plausible(c)
         self.pieces = []
         for c in self.curves:
             if c.strip is not None:
@@ -127,8 +136,6 @@ class JointObjective:
             else:
                 stretch, stress = np.asarray(c.stretch, float), np.asarray(c.stress, float)
             peak = float(np.max(np.abs(stress)))
-            if peak <= 0:
-                raise ColonsimError(f"{c.name}: the stress is zero throughout; check the stress column and its unit")
             base = np.full(stress.size, peak) if residuals == "absolute" else np.maximum(np.abs(stress), RELATIVE_FLOOR * peak)
             model = None
             if strip_model == "fe" and c.strip is not None:
@@ -167,6 +174,7 @@ class JointResult:
     fit: dict
     settings: dict = field(default_factory=dict)
     curves: list = field(default_factory=list, repr=False)
+    warnings: list = field(default_factory=list)  # curves the law does not follow (curve_checks.misfit_warnings)
 
     @property
     def parameter_dict(self):
@@ -178,14 +186,6 @@ class JointResult:
         law = calibration_law(self.law)
         return law.initial_shear_modulus(self.parameters), self.uncertainty.linear_combination_std(
             law.shear_modulus_gradient(self.parameters))
-
-
-def curve_quality(stress_exp, stress_fit) -> dict:
-    """R^2 and RMS (Pa) of one curve's fit."""
-    r = np.asarray(stress_exp) - np.asarray(stress_fit)
-    ss_tot = float(np.sum((stress_exp - np.mean(stress_exp)) ** 2))
-    return {"r2": 1.0 - float(r @ r) / ss_tot if ss_tot > 0 else None, "rms_Pa": float(np.sqrt(np.mean(r**2))),
-            "max_abs_Pa": float(np.max(np.abs(r)))}
 
 
 def polish(objective: JointObjective, outcome, bounds, names):
@@ -253,11 +253,13 @@ def calibrate_joint(curves, law, residuals="relative", budget: Budget | None = N
                                 f"({exc}), so their uncertainty is unknown; fit {model.name} in closed form "
                                 "(--analytic) or choose another law") from None
     rows, fitted = [], []
+    n_total = sum(p.stretch.size for p in objective.pieces)
     for piece, pred in zip(objective.pieces, objective.predictions(theta)):
         c = piece.curve
+        share = len(names) * piece.stretch.size / n_total  # the parameters a curve's points absorb
         rows.append({"curve": c.name, "mode": c.mode, "weight": c.weight, "n_points": int(piece.stretch.size),
                      "max_stretch": float(piece.stretch[-1]), "max_stress_Pa": float(np.max(piece.stress)),
-                     **curve_quality(piece.stress, pred)})
+                     **curve_misfit(c, piece.stretch, piece.stress, pred, share)})
         fitted.append(pd.DataFrame({"curve": c.name, "mode": c.mode, "stretch": piece.stretch,
                                     "stress_exp_Pa": piece.stress, "stress_fit_Pa": pred}))
     r = objective.target - objective.simulate(theta)
@@ -267,6 +269,7 @@ def calibrate_joint(curves, law, residuals="relative", budget: Budget | None = N
            "strip_model": strip_model if any(c.strip is not None for c in objective.curves) else None}
     settings = {"seed": seed, "budget": budget.__dict__.copy(), "bounds": {n: list(bounds[n]) for n in names},
                 "bounds_rule": "from the data (colonsim.identification.joint)", "initial": initial}
+    warnings = misfit_warnings(model.name, rows, objective.curves, model.initial_shear_modulus(theta))
     return JointResult(model.name, names, theta, history, stages, outcome.sensitivity, unc,
                        pd.DataFrame(rows), pd.concat(fitted, ignore_index=True),
-                       check_stability(model, theta, stability_range), fit, settings, objective.curves)
+                       check_stability(model, theta, stability_range), fit, settings, objective.curves, warnings)

@@ -3,9 +3,11 @@
 Layout of the output folder::
 
     material.json    law, parameters (Pa; Ogden exponents dimensionless), uncertainty, per-curve fit
-                     quality, the Drucker stability check and its warning (colonsim-material/1)
+                     quality, the Drucker stability check, and the warnings: curves the law does
+                     not follow, with the likely cause, and Drucker instability (colonsim-material/1)
     fit.csv          every curve's measured and fitted nominal stress at its stretches
-    curves.csv       one row per curve: mode, weight, points, R^2, RMS (Pa)
+    curves.csv       one row per curve: mode, weight, points, R^2, RMS (Pa), the RMS against the curve's
+                     own noise and whether the law follows it (colonsim.identification.curve_checks)
     history.csv      every objective evaluation (stage, parameters, e1)
     modes.png        every mode's data and fit, residuals below
     laws.csv, laws.png, laws/<law>/   with --compare-laws: one row per law (stability included)
@@ -48,7 +50,7 @@ def material_document(result: JointResult, selection=None, level=0.95) -> dict:
         "units": "Pa", "parameter_units": dict(zip(law.parameter_names, law.units)),
         "parameters": result.parameter_dict,
         "small_strain": {"mu0_Pa": mu0, "mu0_sd_Pa": sd_for_json(mu0_sd), "E0_Pa": 3.0 * mu0},  # null: not identified
-        "warnings": [warning] if warning else [],
+        "warnings": [*result.warnings, *([warning] if warning else [])],
         "stability": result.stability.to_dict(),
         "uncertainty": {k: v for k, v in unc.items() if k not in ("correlation", "covariance")},
         "correlation": {"names": list(result.names), "matrix": unc["correlation"]},

@@ -14,7 +14,8 @@ Cauchy stress becomes nominal stress by ``P = sigma / l`` in all three modes (th
 direction's cross-section shrinks by ``l`` in each: uniaxial, equibiaxial and planar alike, J = 1).
 
 A mode manifest is a CSV ``specimen,file,mode`` with optional ``weight`` and the geometry columns
-``length_mm,width_mm,thickness_mm``: a file holding a force-displacement curve of a strip (read by
+``length_mm,width_mm,thickness_mm``; any other column (a misspelt ``weight``) is refused naming the
+one likely meant, and a file or specimen listed twice is refused (it would weigh double). A file holding a force-displacement curve of a strip (read by
 :func:`colonsim.identification.testdata.read_curve`) needs its geometry and is a uniaxial test.
 """
 
@@ -28,10 +29,13 @@ from pathlib import Path
 import numpy as np
 
 from colonsim.errors import ColonsimError
+from colonsim.schemas import check_listed_once, check_manifest_columns
 from colonsim.identification.export_layout import read_text
 from colonsim.identification.hyperelastic import MODES
 from colonsim.identification.testdata import TensileCurve, check_input_file, read_curve
 
+MODE_MANIFEST_REQUIRED = ("specimen", "file", "mode")
+MODE_MANIFEST_OPTIONAL = ("weight", "length_mm", "width_mm", "thickness_mm")
 STRESS_UNITS = {"pa": 1.0, "kpa": 1e3, "mpa": 1e6, "n/mm2": 1e6, "gpa": 1e9, "kgf/cm2": 9.80665e4, "psi": 6894.757293168}
 STRESS_MEASURES = {"nominal": "nominal", "cauchy": "cauchy", "true": "cauchy"}
 # "nominal_stress [MPa]", or the unit after an underscore ("nominal_stress_MPa") when it is a known one
@@ -203,12 +207,12 @@ def read_mode_manifest(path, stress_measure=None, displacement_unit=None, force_
     check_input_file(path, "manifest")
     text, _ = read_text(path)
     reader = csv.DictReader(r for r in text.splitlines() if r.strip() and not r.lstrip().startswith("#"))
-    fields = [c.strip() for c in (reader.fieldnames or [])]
-    missing = [c for c in ("specimen", "file", "mode") if c not in fields]
-    if missing:
-        raise ColonsimError(f"{path}: a mode manifest needs the column(s) {', '.join(missing)} (specimen,file,mode)")
+    check_manifest_columns(reader.fieldnames or [], path, MODE_MANIFEST_REQUIRED, MODE_MANIFEST_OPTIONAL)
+    rows = [{k.strip(): (v or "").strip() for k, v in row.items() if isinstance(k, str)} for row in reader]
+    check_listed_once([(r["specimen"], r["specimen"]) for r in rows], path, "specimen name")
+    check_listed_once([(r["specimen"], (path.parent / r["file"]).resolve()) for r in rows], path)
     curves = []
-    for r in ({k.strip(): (v or "").strip() for k, v in row.items() if isinstance(k, str)} for row in reader):
+    for r in rows:
         name, mode = r["specimen"], r["mode"].lower()
         check_mode(f"{path}: specimen {name!r}", mode)
         try:

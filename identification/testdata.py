@@ -26,6 +26,7 @@ import numpy as np
 from colonsim.errors import ColonsimError
 from colonsim.inputs import check_input
 from colonsim.limits import TEXT_FILE_MAX_BYTES
+from colonsim.schemas import check_listed_once, check_manifest_columns
 from colonsim.identification.export_geometry import stated_geometry
 from colonsim.identification.export_layout import parse_column_name, read_export, read_text, unit_text
 
@@ -233,11 +234,7 @@ def read_manifest(path, displacement_unit=None, force_unit=None):
     check_input_file(path, "manifest")
     text, _ = read_text(path)
     reader = csv.DictReader(row for row in text.splitlines() if not row.lstrip().startswith("#"))
-    fields = [c.strip() for c in (reader.fieldnames or [])]
-    required = ["specimen", "file", "length_mm", "width_mm", "thickness_mm"]
-    missing = [c for c in required if c not in fields]
-    if missing:
-        raise ColonsimError(f"{path}: manifest lacks the column(s) {', '.join(missing)}; expected {','.join(required)}")
+    check_manifest_columns(reader.fieldnames or [], path, ("specimen", "file", "length_mm", "width_mm", "thickness_mm"), ())
     rows = [{k.strip(): (v or "").strip() for k, v in r.items() if isinstance(k, str)} for r in reader]
     if not rows:
         raise ColonsimError(f"{path}: manifest lists no specimens")
@@ -251,6 +248,7 @@ def read_manifest(path, displacement_unit=None, force_unit=None):
             raise ColonsimError(f"{path}: specimen {name!r} is listed twice (its results would overwrite each other); "
                                 "give every row its own name")
         seen.add(name)
+    check_listed_once([(r["specimen"], (path.parent / r["file"]).resolve()) for r in rows], path)
     curves = []
     for r in rows:
         geometry = {}

@@ -17,7 +17,11 @@ quantity a run is). From the errors ``e = y - mean`` and the standardized errors
 
 Held-out runs that set an input the model keeps fixed to another value cannot be scored (the model
 knows nothing of that value) and are counted as left out; runs slightly outside the box of the
-training runs are scored and counted (``outside_box``).
+training runs are scored and counted (``outside_box``). Each run counts once: a key on several rows
+is scored on its first (``duplicates`` counts the others). A run at the inputs of a training run
+(the same case, to :data:`SAME_CASE` relative) is not held out: it is left out and counted
+(``training_cases``), and a table whose runs are all training cases (the training table itself)
+is refused.
 """
 
 from __future__ import annotations
@@ -33,6 +37,7 @@ from colonsim.surrogate.domain import OutOfDomainWarning
 from colonsim.surrogate.table import numeric_column, successful_runs
 
 NOMINAL = (0.5, 0.9, 0.95)
+SAME_CASE = 1e-6  # relative difference of every input below which two runs are one case
 RELIABILITY_LEVELS = tuple(np.round(np.arange(0.05, 1.0, 0.05), 2))
 
 
@@ -44,8 +49,10 @@ def interval_z(level):
 def heldout_runs(model, table: pd.DataFrame, segment, target, name="held-out table"):
     """The held-out runs of ``segment`` with a value of ``target``, checked against the model.
 
-    Returns (X, y, scope diameters, left out, outside the box): the model's input matrix and
-    outputs of the runs it can score, and the counts of runs left out and scored outside the box."""
+    Returns (X, y, scope diameters, left out, outside the box, training cases, duplicates): the
+    model's input matrix and outputs of the runs it can score, and the counts of runs left out (a
+    fixed input set to another value), scored outside the box, left out as training cases, and rows
+    of a key already counted."""
     domain, _ = model.model_for(segment, target)
     missing = [c for c in domain.inputs if c not in table.columns]
     if missing:
@@ -54,6 +61,11 @@ def heldout_runs(model, table: pd.DataFrame, segment, target, name="held-out tab
     if target not in table.columns:
         raise ColonsimError(f"{name} has no column {target}; score a target the table holds")
     runs = successful_runs(table, domain.segment)
+    duplicates = 0
+    if "key" in runs.columns:  # each run once
+        twice = runs["key"].duplicated()
+        duplicates = int(twice.sum())
+        runs = runs[~twice].reset_index(drop=True)
     if runs.empty:
         raise ColonsimError(f"{name} has no successful {domain.segment} run; the model was fitted on "
                             f"{', '.join(model.domains_)}")
@@ -66,12 +78,29 @@ def heldout_runs(model, table: pd.DataFrame, segment, target, name="held-out tab
     fixed_off = np.array(["every" in r for r in reasons], dtype=bool)  # a fixed input set to another value
     outside = np.array([bool(r) for r in reasons]) & ~fixed_off
     keep = ~fixed_off
+    same = keep & training_cases(X, model.model_for(segment, target)[1])
+    if same.any() and same.sum() == keep.sum():
+        raise ColonsimError(f"{name}: every one of its {int(keep.sum())} {domain.segment} runs is a case the model was "
+                            "fitted on (the same inputs as a training run), so none is held out; score the model on "
+                            "runs of another sweep")
+    keep &= ~same
     if keep.sum() < 2:
         raise ColonsimError(f"{name}: {int(keep.sum())} {domain.segment} run(s) with a value of {target} inside the "
                             f"model's fixed inputs ({domain.describe()}); score on at least 2")
     scope = (X[:, domain.inputs.index("scope_diameter_mm")] if "scope_diameter_mm" in domain.inputs
              else np.full(len(X), domain.fixed.get("scope_diameter_mm", np.nan)))
-    return X[keep], y[keep], scope[keep], int(fixed_off.sum()), int(outside[keep].sum())
+    return X[keep], y[keep], scope[keep], int(fixed_off.sum()), int(outside[keep].sum()), int(same.sum()), duplicates
+
+
+def training_cases(X, gp) -> np.ndarray:
+    """Which rows of ``X`` are at the inputs of one of ``gp``'s training runs (:data:`SAME_CASE`)."""
+    X_train = gp.training_runs()[0]
+    scale = np.maximum(np.abs(X_train).max(axis=0), 1e-300) if len(X_train) else 1.0
+    same = np.zeros(len(X), dtype=bool)
+    for start in range(0, len(X), 256):  # 256 x training runs x inputs at a time
+        part = X[start:start + 256]
+        same[start:start + 256] = (np.abs(part[:, None, :] - X_train[None, :, :]) <= SAME_CASE * scale).all(axis=2).any(axis=1)
+    return same
 
 
 def coverage(err, sd, level):
@@ -105,7 +134,7 @@ def score(model, table: pd.DataFrame, target, segment=None, name="held-out table
             raise ColonsimError(f"give --segment ({', '.join(model.domains_)})")
         segment = next(iter(model.domains_))
     domain, gp = model.model_for(segment, target)
-    X, y, scope, left_out, outside = heldout_runs(model, table, segment, target, name)
+    X, y, scope, left_out, outside, same, duplicates = heldout_runs(model, table, segment, target, name)
     _, trend_cov = gp.predict(X, return_cov=True)
     mean, sd = gp.predict(X, return_std=True)  # new simulation results: trend + scatter
     cov = trend_cov.copy()  # the trends' covariance between runs, each run's own sd on the diagonal
@@ -116,7 +145,7 @@ def score(model, table: pd.DataFrame, target, segment=None, name="held-out table
     stated, held = pair_orders(mean, cov, scope)
     holds = held(y)
     return {"segment": domain.segment, "target": target, "n": int(len(y)), "left_out": left_out,
-            "outside_box": outside, "n_train": gp.n_train, "error_unknown": model.error_unknown(domain.segment, target),
+            "training_cases": same, "duplicates": duplicates, "outside_box": outside, "n_train": gp.n_train, "error_unknown": model.error_unknown(domain.segment, target),
             "rmse": float(np.sqrt(np.mean(err**2))), "q2": float(1.0 - np.sum(err**2) / ss) if ss > 0 else None,
             "coverage": {f"{round(100 * p)}": coverage(err, sd, p) for p in NOMINAL},
             "z_mean": float(z.mean()), "z_sd": float(z.std(ddof=1)),
@@ -131,7 +160,9 @@ def format_score(s, unit="") -> str:
     cov = s["coverage"]
     lines = [f"{s['segment']} {s['target']}: model fitted on {s['n_train']} runs, scored on {s['n']} held-out runs"
              + (f" ({s['left_out']} left out: a fixed input set to another value)" if s["left_out"] else "")
-             + (f"; {s['outside_box']} slightly outside the training box" if s["outside_box"] else ""),
+             + (f"; {s['outside_box']} slightly outside the training box" if s["outside_box"] else "")
+             + (f"; {s['training_cases']} left out as cases the model was fitted on" if s.get("training_cases") else "")
+             + (f"; {s['duplicates']} row(s) of a run already counted left out" if s.get("duplicates") else ""),
              f"  RMSE {s['rmse']:.3g} {unit}  Q2 {'-' if s['q2'] is None else format(s['q2'], '.3f')}".rstrip(),
              f"  coverage of the 50 / 90 / 95 % intervals: {100 * cov['50']:.0f} / {100 * cov['90']:.0f} / "
              f"{100 * cov['95']:.0f} %",

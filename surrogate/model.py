@@ -16,7 +16,7 @@ import pandas as pd
 
 from colonsim.errors import ColonsimError
 from colonsim.surrogate.domain import SegmentDomain
-from colonsim.surrogate.replicates import replicate_scatter
+from colonsim.surrogate.replicates import replicate_scatter, unmatched_replicates
 from colonsim.surrogate.gp import GaussianProcess
 from colonsim.surrogate.larger import LargerOf, cross_validate_larger, identity_holds
 from colonsim.surrogate.table import (INPUT_OPTIONS, INPUTS, PAIN_PROXY, TARGETS, check_results, numeric_column,
@@ -187,6 +187,8 @@ class SweepSurrogate:
                 fitted[target] = (keep, y[keep], make_gp)
             for store in (self.models_, self.cv_, self.skipped_, self.scatter_):  # in the order of the targets
                 store[segment] = {t: store[segment][t] for t in self.targets if t in store[segment]}
+        if replicates is not None:
+            unmatched_replicates(replicates, self.scatter_)
         self.tissue_, note = ((self.tissue, None) if self.tissue is not None
                               else TissueDistribution.from_runs(table[table["status"] == "ok"]))
         if note and any(tissue_inputs(d) for d in self.domains_.values()):

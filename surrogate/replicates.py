@@ -73,3 +73,15 @@ def replicate_scatter(runs: pd.DataFrame, replicates: pd.DataFrame, segment, inp
     d = np.asarray(d)
     return {"sd": float(np.std(d, ddof=1) / np.sqrt(2.0)), "pairs": int(len(d)), "offset": float(np.mean(d)),
             "unpaired": int(sum(key not in paired for key in _keys(reps, inputs)))}
+
+
+def unmatched_replicates(replicates: pd.DataFrame, scatter: dict):
+    """Refuse a replicate table that gave no noise floor at all (``scatter``: segment -> target ->
+    the result of :func:`replicate_scatter`): its runs are of no segment the model fits (another
+    segment's table, another study), so the floor the user asked for would silently be missing."""
+    if any(s is not None for by_target in scatter.values() for s in by_target.values()):
+        return
+    segments = sorted({str(s) for s in replicates.loc[replicates["status"] == "ok", "segment"]})
+    raise ColonsimError(f"the replicate table matches no run of the model: its successful runs are of "
+                        f"{', '.join(segments) or 'no segment'}, the model fits {', '.join(scatter) or 'no segment'}; "
+                        "give the results table of the training cases run again (or leave out --replicates)")

@@ -15,8 +15,8 @@ import pandas as pd
 
 from colonsim import catalog
 from colonsim.errors import ColonsimError
-from colonsim.inputs import check_input
-from colonsim.limits import TABLE_MAX_BYTES
+from colonsim.inputs import check_input, read_input_text
+from colonsim.limits import QUERY_MAX_BYTES, TABLE_MAX_BYTES
 
 # Derived from the catalog's columns (colonsim.catalog.COLUMNS), for the modules that import them.
 SEGMENTS = catalog.segment_names()
@@ -45,6 +45,22 @@ def read_results(path) -> pd.DataFrame:
     except Exception as exc:  # pyarrow and pandas raise many types for a damaged file
         raise ColonsimError(f"cannot read results table {path}: {str(exc).splitlines()[0]}") from None
     return check_results(frame, str(path))
+
+
+def read_query_file(path) -> pd.DataFrame:
+    """The queries of a CSV file (``colonsim predict --csv``), one a row, read within
+    :data:`colonsim.limits.QUERY_MAX_BYTES`; a file with a header and no rows is refused."""
+    import io
+
+    text = read_input_text(path, "query file", QUERY_MAX_BYTES)
+    try:
+        frame = pd.read_csv(io.StringIO(text))
+    except (pd.errors.ParserError, pd.errors.EmptyDataError) as exc:
+        raise ColonsimError(f"cannot read {path}: {str(exc).splitlines()[0]}") from None
+    if frame.empty:
+        raise ColonsimError(f"query file {path} has a header ({', '.join(map(str, frame.columns))}) but no rows; add "
+                            "one query a row")
+    return frame
 
 
 def check_results(frame: pd.DataFrame, name="results table") -> pd.DataFrame:

@@ -100,7 +100,7 @@ def test_vtu_snapshots_are_bounded_before_the_runs(tmp_path, capsys, monkeypatch
     code = main(["insert", "--segment", "straight", "--vtu", "--snapshot-every", "1e-300", "--no-progress",
                  "--out", str(tmp_path / "o")])
     err = capsys.readouterr().err.strip().splitlines()
-    assert code == 2 and len(err) == 1 and "--snapshot-every 1e-300 s is outside 0.001-10 s" in err[0], err
+    assert code == 2 and len(err) == 1 and "--snapshot-every: 1e-300 is outside 0.001-10" in err[0], err
     assert not (tmp_path / "o").exists()
 
 

@@ -22,6 +22,7 @@ import pytest
 
 from colonsim.errors import ColonsimError
 from colonsim.files import STAGING_PREFIX, output_set, write_json
+from colonsim.insertion.case.scenario import InsertionCase
 from colonsim.insertion.study.sweep import LOCK, TABLE, SweepStore
 
 EARLIER = {"material.json": b'{"law": "earlier"}\n', "fit.csv": b"earlier,fit\n", "history.csv": b"a,b\n1,2\n",
@@ -255,16 +256,15 @@ SCRIPT_TABLE = textwrap.dedent("""
 def test_sweep_table_and_lock_survive_a_failed_table_write(tmp_path):
     out = tmp_path / "sweep"
     store = SweepStore(out)
-    with store:
-        store.rows["done"] = {"key": "done", "status": "ok", "error": "", "quasi_static": True,
-                              "kinetic_energy_check": True, "ended_by": "far_end"}
-        store.write()
+    case = InsertionCase(segment="straight", scope="utc")
+    with store:  # a finished run's row as the sweep records it (a resume checks its key against its inputs)
+        store.record(case, {"status": "failed", "error": "x", "wall_time_s": 1.0, "finished_at": "2026-01-01T00:00:00"})
     before = (out / TABLE).read_bytes()
     proc = run([sys.executable, "-c", SCRIPT_TABLE, str(out)], preexec=limited(24), timeout=30)
     assert proc.returncode == 2 and "file-size limit" in proc.stderr, proc.stderr
     assert (out / TABLE).read_bytes() == before  # the finished run's row is still there
     assert not (out / LOCK).exists()  # released, so the next resume is not told another sweep runs
-    assert list(pd.read_parquet(out / TABLE)["key"]) == ["done"]
+    assert list(pd.read_parquet(out / TABLE)["key"]) == [case.key()]
     assert sorted(p.name for p in out.iterdir()) == [TABLE]
 
 

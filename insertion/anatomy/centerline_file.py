@@ -1,7 +1,8 @@
 """Reader of a patient's centerline CSV (docs/model.md, "A patient's centerline").
 
-Format: a comma-separated text file; lines starting with ``#`` are comments (say where the
-points come from), blank lines are skipped. The first other line is the header; the units are
+Format: a comma-separated text file (or semicolon- or tab-separated, whose numbers may then have
+a decimal comma, as spreadsheets in German or French locales save them); lines starting with
+``#`` are comments (say where the points come from), blank lines are skipped. The first other line is the header; the units are
 part of the column names:
 
 ========================  =========================================================================
@@ -93,7 +94,9 @@ def _header(cells, path, line):
     return names
 
 
-def _number(text, column, path, line):
+def _number(text, column, path, line, decimal="."):
+    if decimal == "," and "," in text and "." not in text:
+        text = text.replace(",", ".")
     try:
         value = float(text)
     except ValueError:
@@ -104,24 +107,28 @@ def _number(text, column, path, line):
 
 
 def _rows(path: Path):
-    """(line number, cells) of the header and each data row."""
+    """(line number, cells) of the header and each data row, and the decimal mark: a header
+    split by semicolons (or tabs) rather than commas leaves the comma to decimals, as a spreadsheet
+    in a German or French locale saves it."""
     text = read_input_text(path, "centerline file", TEXT_FILE_MAX_BYTES, fallbacks=("cp1252",))
     lines = text.splitlines()
+    header = next((ln for ln in lines if ln.strip() and not ln.lstrip().startswith("#")), "")
+    delimiter = max((",", ";", "\t"), key=header.count)
     rows = []
-    for number, cells in zip(range(1, len(lines) + 1), csv.reader(lines)):
+    for number, cells in zip(range(1, len(lines) + 1), csv.reader(lines, delimiter=delimiter)):
         if not cells or all(not c.strip() for c in cells) or cells[0].lstrip().startswith("#"):
             continue
         rows.append((number, cells))
     if not rows:
         raise ColonsimError(f"centerline file {path} holds no header; the first line must name the columns "
                             "x_mm, y_mm, z_mm, label")
-    return rows
+    return rows, "." if delimiter == "," else ","
 
 
 def read_centerline_points(path) -> CenterlinePoints:
     """Read and check a centerline CSV (module docstring); raise :class:`ColonsimError` on bad input."""
     path = Path(path)
-    (header_line, header), *data = _rows(path)
+    ((header_line, header), *data), decimal = _rows(path)
     columns = _header(header, path, header_line)
     points, labels, names, diameters, lines = [], [], [], [], []
     label = name = None
@@ -131,7 +138,7 @@ def read_centerline_points(path) -> CenterlinePoints:
                                 "remove the extra cells or name their column")
         row = dict(zip(columns, (c.strip() for c in cells)))
         row.update({c: "" for c in columns if c not in row})
-        points.append([_number(row[c], c, path, line) for c in COORDINATES])
+        points.append([_number(row[c], c, path, line, decimal) for c in COORDINATES])
         if any(abs(v) > COORDINATE_LIMIT_MM for v in points[-1]):
             raise ColonsimError(f"{path} line {line}: a coordinate beyond {COORDINATE_LIMIT_MM:g} mm; give the "
                                 "coordinates in mm")
@@ -150,7 +157,7 @@ def read_centerline_points(path) -> CenterlinePoints:
         names.append(name)
         if "diameter_mm" in columns:
             diameters.append(math.nan if not row["diameter_mm"]
-                             else _number(row["diameter_mm"], "diameter_mm", path, line))
+                             else _number(row["diameter_mm"], "diameter_mm", path, line, decimal))
             low, high = DIAMETER_RANGE_MM
             if not (math.isnan(diameters[-1]) or low <= diameters[-1] <= high):
                 raise ColonsimError(f"{path} line {line}: diameter_mm = {diameters[-1]:g} is outside "

@@ -13,7 +13,11 @@ that were in flight; failed runs are recorded with their error (rerun them with
 ``retry_failed=True``) and never stop the others. ``reuse`` takes the finished runs of the same
 cases (the same key: every input equal) from other sweep folders instead of running them again;
 their rows keep the code version that made them. A folder holds one sweep: another sweep (other
-cases) written into it is refused, so that one table never mixes two sweeps.
+cases) written into it is refused, so that one table never mixes two sweeps. A table, a
+``sweep.json`` or a finished run's folder that is not as the sweep wrote it (a column renamed,
+dropped or turned into text, a key or an input edited, a run folder deleted) is refused before
+any run starts, with nothing written (:mod:`colonsim.schemas`,
+:mod:`colonsim.insertion.study.sweep_table`); so is a folder named by ``reuse`` whose table is.
 
 Runs go to a local process pool or an existing Dask distributed cluster
 (:mod:`colonsim.insertion.study.sweep_outcomes`); both yield outcomes as runs finish, and only this process writes files:
@@ -34,11 +38,13 @@ import pandas as pd
 from colonsim.errors import ColonsimError
 from colonsim.files import atomic_path, check_entries, check_output_folder, output_set, write_json
 from colonsim.provenance import code_version
+from colonsim.schemas import check_run_folders, check_sweep_document
 from colonsim.insertion.case.results import RUN_SUMMARY
 from colonsim.insertion.case.run_budget import DEFAULT_MAX_STEPS, check_sweep_budget
 from colonsim.insertion.case.scenario import InsertionResult
 from colonsim.insertion.study.sweep_outcomes import dask_distributed, dask_outcomes, local_outcomes
 from colonsim.insertion.study.sweep_rows import IDENTITY, OUTPUTS, input_columns, input_row, result_row
+from colonsim.insertion.study.sweep_table import read_table
 
 TABLE = "results.parquet"
 SWEEP_DOCUMENT = "sweep.json"
@@ -56,12 +62,11 @@ class SweepStore:
         self._lock = None
 
     def load(self):
-        """Read the rows already in the table (no lock needed: the table is replaced atomically)."""
+        """Read the rows already in the table (no lock needed: the table is replaced atomically),
+        refused as a whole if it is not as the sweep wrote it (:mod:`colonsim.schemas`)."""
         if self.table_path.is_file():
-            try:
-                table = pd.read_parquet(self.table_path)
-            except Exception as exc:
-                raise ColonsimError(f"cannot read {self.table_path} ({exc}); move it away to start the sweep afresh") from None
+            table = read_table(self.table_path)
+            check_run_folders(self.folder, table, RUN_SUMMARY)
             self.rows = {row["key"]: row for row in table.to_dict("records")}
 
     def __enter__(self):
@@ -110,10 +115,11 @@ class SweepStore:
 
             try:
                 held = json.loads(path.read_text(encoding="utf-8"))
-                held_keys, held_source = set(held["keys"]), held.get("toml")
-            except (ValueError, KeyError, TypeError) as exc:
+            except ValueError as exc:
                 raise ColonsimError(f"cannot read {path} ({type(exc).__name__}); it should name the sweep this folder "
                                     "holds: use another --out") from None
+            check_sweep_document(held, path)
+            held_keys, held_source = set(held["keys"]), held.get("toml")
             if held_keys == keys or (source and held_source == source):
                 return None
             name = held.get("name")
@@ -184,7 +190,7 @@ class SweepStore:
         frame["quasi_static"] = frame["quasi_static"].fillna(False).astype(bool)
         # rows written before these columns existed: unknown (<NA> / ""), not "failed"
         frame["kinetic_energy_check"] = frame["kinetic_energy_check"].astype("boolean")
-        frame["ended_by"] = frame["ended_by"].fillna("").astype(str)
+        frame["ended_by"] = frame["ended_by"].astype(object).where(frame["ended_by"].notna(), "").astype(str)
         return frame.reset_index(drop=True)
 
     def write(self):
@@ -328,11 +334,11 @@ def run_sweep(cases, out, workers=2, scheduler=None, runner=None, retry_failed=F
 
 
 def read_results(folder) -> pd.DataFrame:
-    """The results table of a sweep folder."""
+    """The results table of a sweep folder, checked (:func:`colonsim.insertion.study.sweep_table.read_table`)."""
     path = Path(folder) / TABLE
     if not path.is_file():
         raise ColonsimError(f"no {TABLE} in {folder}; run `colonsim sweep ... --out {folder}` first")
-    return pd.read_parquet(path)
+    return read_table(path)
 
 
 def describe_cases(cases) -> str:
