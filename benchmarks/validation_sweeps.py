@@ -24,6 +24,7 @@ from colonsim.insertion.case.results import RUN_SUMMARY
 from colonsim.insertion.case.insertion_case import ABSENT_AT
 from colonsim.insertion.case.scenario import InsertionCase
 from colonsim.insertion.study.run_rules import RULES, apply_current_rules
+from colonsim.insertion.study.sweep_table import case_from_row
 from colonsim.insertion.study.sweep import TABLE, read_results
 from colonsim.insertion.study.sweep_spec import load_sweep, parse_sweep
 
@@ -91,23 +92,6 @@ class Sweep:
                 "rules": {str(k): int(v) for k, v in rules.items() if k}}
 
 
-def _row_case(row) -> InsertionCase:
-    """The case of a table row (its input columns)."""
-    values = {}
-    for f in dataclasses.fields(InsertionCase):
-        if f.name not in row.index:  # a table of older code: the field did not exist, the value of before ran
-            if f.name in ABSENT_AT:
-                values[f.name] = ABSENT_AT[f.name]
-            continue
-        v = row[f.name]
-        if f.default is None:  # optional inputs: "" in the table means absent; dicts are JSON text
-            v = (json.loads(v) if "dict" in str(f.type) else v) if isinstance(v, str) and v else None
-        elif isinstance(f.default, float):
-            v = float(v)
-        values[f.name] = v
-    return InsertionCase(**values)
-
-
 def read_sweep(label, folder, preset=None, optional=False) -> Sweep:
     """The sweep in ``folder``. Without a results table there, the report's optional sweeps
     (``preset`` given: defined by the preset; ``optional``: with no runs) come back empty; the
@@ -136,7 +120,7 @@ def read_sweep(label, folder, preset=None, optional=False) -> Sweep:
         cases = [recorded_case(c, set(table["key"])) for c in cases]
         table = table[table["key"].isin({c.key() for c in cases})].reset_index(drop=True)
     else:  # a table without its record: the runs in it are the sweep
-        cases = [_row_case(row) for _, row in table.iterrows()]
+        cases = [case_from_row(row) for _, row in table.iterrows()]
     return Sweep(label, folder, cases, apply_current_rules(table, folder), True)
 
 

@@ -17,6 +17,7 @@ import pandas as pd
 
 from colonsim import schemas
 from colonsim.errors import ColonsimError
+from colonsim.insertion.case.insertion_case import ABSENT_AT
 from colonsim.insertion.case.scenario import InsertionCase
 from colonsim.insertion.study.sweep_rows import result_row
 
@@ -40,13 +41,16 @@ def _missing(value) -> bool:
 
 
 def case_from_row(row) -> InsertionCase:
-    """The case a results row records (an input the row lacks, or leaves empty, at its default:
-    how the sweep wrote rows of before the input existed)."""
+    """The case a results row records: an input the row leaves empty at its default; an input the
+    table lacks at the value that made the runs of before the input existed (``ABSENT_AT``: the
+    time-step estimate of a table of before is "bounds", whatever today's default)."""
     defaults = InsertionCase()
     values = {}
     for f in _FIELDS:
         value = row.get(f.name)
-        if _missing(value):
+        if f.name not in row.index and f.name in ABSENT_AT:
+            value = ABSENT_AT[f.name]
+        elif _missing(value):
             value = getattr(defaults, f.name)
         elif f.name == "material_parameters" and isinstance(value, str):
             value = json.loads(value)
