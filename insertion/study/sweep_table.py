@@ -48,7 +48,7 @@ def case_from_row(row) -> InsertionCase:
     values = {}
     for f in _FIELDS:
         value = row.get(f.name)
-        if f.name not in row.index and f.name in ABSENT_AT:
+        if f.name not in row and f.name in ABSENT_AT:  # a dict or a Series: "in" looks at its keys
             value = ABSENT_AT[f.name]
         elif _missing(value):
             value = getattr(defaults, f.name)
