@@ -119,9 +119,9 @@ def _rule(old, new, quantity):
     if new.get("why"):
         return new["why"]
     if old is None:
-        return ("judged since the rules of 2026-12-07: the largest lag" if quantity == "lag" else
+        return ("judged since the rules of 2026-12-07: the largest lag" if quantity in ("lag", "max_lag_cm") else
                 "judged since the rules of 2026-12-07: the count of snap-throughs at half the speed"
-                if quantity == "snap-throughs" else "judged now")
+                if quantity in ("snap-throughs", "snap_throughs") else "judged now")
     return "its numbers moved"
 
 

@@ -207,7 +207,8 @@ def rate_changes(base, variant, segment) -> dict:
     relative change (None below the quantity's floor), tolerance and verdict; and ``passed``."""
     quantities, passed = pair_quantities(base, variant, segment, "rate")
     return {"changes": {q["column"]: {"change": None if not np.isfinite(q["change"]) else q["change"],
-                                      "limit": q["tolerance"], "passed": q["passed"]} for q in quantities},
+                                      "limit": q["tolerance"], "passed": q["passed"], "why": q.get("why", "")}
+                        for q in quantities},
             "passed": passed}
 
 
