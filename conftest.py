@@ -39,7 +39,8 @@ LONG_FIRST = ("tests/test_demo.py", "tests/test_insertion_rsj.py", "tests/test_s
               "tests/test_adaptive_sweep.py", "notebooks/03_sweep_and_surrogate.ipynb",
               "notebooks/02_insertion.ipynb", "tests/test_relax_until_rest.py",
               "tests/test_tissue_uncertainty.py", "tests/test_distal_resistance.py", "tests/test_verification_table.py",
-              "notebooks/04_patient_anatomy.ipynb")
+              "notebooks/04_patient_anatomy.ipynb", "tests/test_docs_snippets.py", "tests/test_api.py",
+              "tests/test_docs_site.py")
 
 
 def pytest_collection_modifyitems(config, items):
