@@ -15,6 +15,7 @@ import warnings
 from pathlib import Path
 
 from colonsim import catalog, cli_material, cli_surrogate, cli_sweep, options
+from colonsim.catalog import STRETCHED_WALL_COLUMN, STRETCHED_WALL_THRESHOLD, STRETCHED_WALL_THRESHOLD_RANGE
 from colonsim.errors import ColonsimError, ColonsimWarning
 from colonsim.files import os_failure
 from colonsim.input_ranges import check_input_range
@@ -157,7 +158,15 @@ def _add_insert(sub):
                    help="N the colon beyond the model opposes to the tip's advance once it is in the fixed exit "
                         "(default 5, the light level of 0/5/10/20; 0: none; docs/model.md, \"Loading\")")
     p.add_argument("--vtu", action="store_true", help="write deformed meshes for ParaView (needs meshio)")
-    p.add_argument("--snapshot-every", type=finite_float, default=0.02, help="simulated seconds between VTU snapshots")
+    p.add_argument("--animate", action="store_true",
+                   help="write insertion.gif per run (insertion.mp4 too when ffmpeg is on the path): the wall coloured "
+                        "by displacement, the scope, the push force (docs/visualisation.md)")
+    p.add_argument("--snapshot-every", type=finite_float, default=0.02,
+                   help="simulated seconds between snapshots for --vtu and --animate (default 0.02)")
+    p.add_argument("--stretch-threshold", type=finite_float, default=None,
+                   help=f"stretch above which the wall counts as stretched in summary.json's {STRETCHED_WALL_COLUMN} "
+                        f"(default {STRETCHED_WALL_THRESHOLD:g}, {STRETCHED_WALL_THRESHOLD_RANGE[0]:g}-"
+                        f"{STRETCHED_WALL_THRESHOLD_RANGE[1]:g}; an assumption)")
     p.add_argument("--threads", type=int, default=None,
                    help="Numba threads (default: all cores). Use 1 when running several insertions side by side: "
                         "oversubscribed threads slow the kernels down by an order of magnitude")
@@ -178,9 +187,13 @@ def cmd_insert(args):
         from colonsim.insertion.case.results import check_vtu_writer
 
         check_vtu_writer()
-        if not 1e-3 <= args.snapshot_every <= 10.0:  # a snapshot per time step would fill memory and disk
-            raise ColonsimError(f"--snapshot-every {args.snapshot_every:g} s is outside 0.001-10 s; give the "
-                                "simulated seconds between VTU snapshots (default 0.02)")
+    if (args.vtu or args.animate) and not 1e-3 <= args.snapshot_every <= 10.0:  # a snapshot per step fills memory
+        raise ColonsimError(f"--snapshot-every {args.snapshot_every:g} s is outside 0.001-10 s; give the "
+                            "simulated seconds between snapshots (default 0.02)")
+    if args.stretch_threshold is not None:
+        from colonsim.insertion.case.stretch_map import check_threshold
+
+        check_threshold(args.stretch_threshold)
     if args.threads is not None:
         if not 1 <= args.threads <= numba.config.NUMBA_NUM_THREADS:
             raise ColonsimError(f"--threads {args.threads} must lie in 1-{numba.config.NUMBA_NUM_THREADS} (the cores Numba sees)")
@@ -206,7 +219,7 @@ def cmd_insert(args):
     from colonsim.workflows import insert
 
     insert(cases, args.out, vtu=args.vtu, snapshot_every=args.snapshot_every, show=not args.no_progress,
-                   max_steps=args.max_steps)
+           max_steps=args.max_steps, animate=args.animate, stretch_threshold=args.stretch_threshold)
 
 
 class OneLineParser(argparse.ArgumentParser):

@@ -10,6 +10,7 @@ from colonsim.insertion.case.outcomes import (JAM_FORCE, JAM_PROGRESS, JAM_PUSH,
                                               REST_WINDOW, RINGING_LIMIT, RINGING_WINDOW, characteristic_points,
                                               peak_trend, quasi_static_fraction, rest_drift, ringing_ratio,
                                               turned_back)
+from colonsim.insertion.case.stretch_map import wall_stretch_summary
 from colonsim.insertion.engine.material import REFERENCE_MATERIAL_PATH
 from colonsim.provenance import code_version
 
@@ -132,4 +133,5 @@ def summarize(model, ts, wall_s, build_s) -> dict:
         "mesh": {**g.summary(), "scope_nodes": int(model.rod.n_nodes), "hinges": int(len(model.shell.hinges))},
         "material": {"law": model.shell.material.law, **model.shell.material.named_parameters,
                      "file": model.case.material or str(REFERENCE_MATERIAL_PATH)},
+        **wall_stretch_summary(model, ts),  # where the wall is stretched (stretch_map.py)
     }
