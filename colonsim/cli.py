@@ -116,8 +116,9 @@ def _add_insert(sub):
     p = sub.add_parser("insert", help="simulate a colonoscope insertion (explicit dynamics)",
                        description="Push a colonoscope through a colon model (docs/model.md) and record the colon "
                                    "deformation, contact and push forces, tip motion and energies. Writes "
-                                   "timeseries.csv, summary.json and insertion.png per scope, a comparison table "
-                                   "and figure, and optional VTU files for ParaView.")
+                                   "timeseries.csv, summary.json, insertion.png and the wall-stretch map "
+                                   "(stretch_map.npz/.png) per scope, a comparison table and figure, and optional "
+                                   "movies (--animate) and VTU files for ParaView.")
     p.add_argument("--segment", default=None, help=f"colon model (default rsj): {options.segment_help()}")
     p.add_argument("--scope", nargs="+", default=["sdc"], help=f"{options.scope_help()}; several allowed (default sdc)")
     p.add_argument("--centerline", type=Path,

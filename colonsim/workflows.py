@@ -338,6 +338,11 @@ def insert(cases, out: Path, vtu=False, snapshot_every=0.02, show=True, max_step
     return results
 
 
+def run_folder(result) -> str:
+    """The name of a run's folder under ``insert``'s output folder: model and scope (``rsj_SDC``)."""
+    return f"{result.case.segment}_{result.summary['scope']['name'].replace(' ', '')}"
+
+
 def _run_cases(cases, budgets, out, stage, outputs, show):
     """Run ``cases`` and write their folders and the comparison into ``stage`` (what becomes
     ``out``); ``outputs``: VTU files, snapshot interval, keys of the cases animated, stretch threshold."""
@@ -369,7 +374,7 @@ def _run_cases(cases, budgets, out, stage, outputs, show):
             bar.close()
         if stretch_threshold is not None:
             restate_threshold(r.summary, r, stretch_threshold)
-        name = f"{case.segment}_{r.summary['scope']['name'].replace(' ', '')}"
+        name = run_folder(r)
         write_insertion(r, stage / name, vtu=vtu, animate=animate)
         folder = out / name
         results.append(r)

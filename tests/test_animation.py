@@ -48,15 +48,15 @@ def fake_ffmpeg(folder, exit_code=0):
 
 @pytest.fixture(scope="module")
 def animated(tmp_path_factory):
-    """``colonsim insert --animate`` on the tests' smallest case (a straight tube at the smoke
-    push), with a stand-in ffmpeg on the path; about 10 s on one core."""
+    """``colonsim insert --animate --vtu`` on the tests' smallest case (a straight tube at the smoke
+    push), with a stand-in ffmpeg on the path; about 15 s on one core."""
     out = tmp_path_factory.mktemp("animated")
     path = os.environ["PATH"]
     os.environ["PATH"] = f"{fake_ffmpeg(tmp_path_factory.mktemp('bin'))}{os.pathsep}{path}"
     try:
         code = main(["insert", "--segment", "straight", "--scope", "utc", "--element-size", "5", "--no-progress",
                      "--push-speed", str(SMOKE_PUSH_SPEED), "--scope-spacing", str(SMOKE_SCOPE_SPACING_MM),
-                     "--animate", "--snapshot-every", "0.01", "--stretch-threshold", "1.05", "--out", str(out)])
+                     "--animate", "--vtu", "--snapshot-every", "0.01", "--stretch-threshold", "1.05", "--out", str(out)])
     finally:
         os.environ["PATH"] = path
     assert code == 0
@@ -87,6 +87,9 @@ def test_insert_writes_the_stretch_map_at_the_threshold_asked(animated):
     assert summary[STRETCHED_WALL_COLUMN] == 0.0 and summary["wall_stretch"]["threshold"] == 1.05
     assert summary["wall_stretch"]["largest"]["A"] is None  # a flat deformation has no point A
     assert (animated / "stretch_map.png").stat().st_size > 10_000
+    meshio = pytest.importorskip("meshio")
+    cells = meshio.read(animated / "vtu" / "colon_stretch.vtu").cell_data
+    assert cells["stretch_max"][0] == pytest.approx(arrays["stretch_max"], abs=1e-6)
     table = pd.read_csv(animated.parent / "comparison.csv")
     assert table[STRETCHED_WALL_COLUMN].iloc[0] == 0.0
 

@@ -10,8 +10,9 @@ from colonsim.errors import ColonsimError
 from colonsim.insertion.anatomy.colon_segments import straight_colon
 from colonsim.insertion.case.outcomes import characteristic_points, principal_stretches
 from colonsim.insertion.case.stretch_figure import stretch_map_figure, unrolled_polygons
-from colonsim.insertion.case.stretch_map import (WallStretch, area_above, check_threshold, stretched_area_section,
-                                                 unrolled_nodes)
+from colonsim.insertion.case.stretch_map import (FIELDS, WallStretch, area_above, check_threshold, read_stretch_map,
+                                                 stretched_area_section, unrolled_nodes, write_stretch_map,
+                                                 write_stretch_vtu)
 from colonsim.insertion.engine.shell_membrane import reference_frames
 
 D, LENGTH, H, FIXED = 0.036, 0.20, 5e-3, 0.03
@@ -161,3 +162,22 @@ def test_the_stretched_area_comes_out_both_ways(tube):
         with pytest.raises(ColonsimError, match="stretch threshold"):
             check_threshold(bad)
     assert COLUMNS[STRETCHED_WALL_COLUMN].unit == "cm2" and COLUMNS[STRETCHED_WALL_COLUMN].label
+
+
+def test_the_map_files_keep_every_field(tube, tmp_path):
+    """The NPZ reads back unchanged; the VTU holds each field as cell data of the rest mesh."""
+    meshio = pytest.importorskip("meshio")
+    g, dm_inv, area = tube
+    tracker = record(g, dm_inv, [1.0, 1.2, 1.1], [0.0, 2.0, 1.0])
+    fields = tracker.fields(series(np.array([0.0, 2.0, 1.0])))
+    arrays = {**{f"stretch_{k}": fields[k].astype(np.float32) for k in FIELDS}, "triangles": g.triangles.astype(np.int32),
+              "held": (g.fixed | g.end_ring)[g.triangles].all(axis=1), "touched": np.zeros(len(g.triangles), bool)}
+    write_stretch_map(arrays, tmp_path)
+    back = read_stretch_map(tmp_path)
+    assert set(back) == set(arrays) and all(np.array_equal(back[k], arrays[k], equal_nan=True) for k in arrays)
+    write_stretch_vtu(arrays, g.nodes, tmp_path / "colon_stretch.vtu")
+    mesh = meshio.read(tmp_path / "colon_stretch.vtu")
+    assert mesh.cells_dict["triangle"].shape == g.triangles.shape
+    assert mesh.cell_data["stretch_max"][0].max() == pytest.approx(1.2, abs=1e-6)
+    assert mesh.cell_data["stretch_A"][0].max() == pytest.approx(1.2, abs=1e-6)
+    assert mesh.cell_data["stretch_end"][0].max() == pytest.approx(1.1, abs=1e-6)

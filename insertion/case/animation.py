@@ -23,6 +23,7 @@ from matplotlib.tri import Triangulation
 from colonsim.errors import ColonsimError, ColonsimWarning
 from colonsim.files import atomic_path
 from colonsim.insertion.anatomy.manoeuvre import SETTLE
+from colonsim.insertion.case.stretch_map import centerline_samples
 
 MAX_FRAMES = 60  # snapshots beyond this are thinned evenly (the first and the last kept)
 FRAME_SECONDS = 0.12  # each frame's display time in the GIF
@@ -60,9 +61,7 @@ def _scene(result):
     """What every frame shares: the far triangles in drawing order and the projection."""
     model = result.model
     x0 = np.asarray(model.shell.x0)
-    g = model.geometry
-    s = np.linspace(0.0, g.centerline_length, max(int(g.centerline_length / 5e-4), 2) + 1)
-    axes, far = view_of(x0, np.asarray(g.centerline_points(s), dtype=float))
+    axes, far = view_of(x0, centerline_samples(model.geometry)[1])
     tri = model.shell.triangles[far[model.shell.triangles].all(axis=1)]
     tri = tri[np.argsort((x0[tri] @ axes[2]).mean(axis=1))]  # the deepest drawn first
     return x0, tri, axes[:2].T

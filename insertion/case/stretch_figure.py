@@ -54,7 +54,8 @@ def stretch_map_figure(arrays, threshold=STRETCHED_WALL_THRESHOLD, title="") -> 
     bar.ax.axhline(threshold, color="c", lw=2)
     for name, (s0, s1) in zip(arrays["flexure_names"], arrays["flexure_m"]):
         ax.axvspan(s0 * 100, s1 * 100, color="tab:blue", alpha=0.12, lw=0)
-        ax.text(0.5 * (s0 + s1) * 100, 183, str(name), ha="center", va="bottom", fontsize=8, color="tab:blue")
+        ax.text(0.5 * (s0 + s1) * 100, 176, str(name), ha="center", va="top", fontsize=8, color="tab:blue",
+                bbox={"facecolor": "w", "alpha": 0.7, "lw": 0, "pad": 1})
     touched = arrays["touched"]
     if touched.any():
         tri = arrays["triangles"][touched]

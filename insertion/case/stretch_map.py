@@ -209,15 +209,20 @@ def restate_threshold(summary, result, threshold) -> None:
         summary["wall_stretch"]["largest"] = largest
 
 
+def centerline_samples(geometry):
+    """The centerline of ``geometry`` sampled every 0.5 mm: arc lengths (m) and points (m)."""
+    length = float(geometry.centerline_length)
+    s = np.linspace(0.0, length, max(int(length / 5e-4), 2) + 1)
+    return s, np.asarray(geometry.centerline_points(s), dtype=float)
+
+
 def unrolled_nodes(geometry, x0):
     """Every wall node's position along the centerline (m) and angle around it (deg, -180 to 180).
 
     The angle is measured in a parallel-transport frame of the centerline sampled every 0.5 mm,
     starting from the direction out of the model's plane (the smallest principal axis of the rest
     wall), so 0 deg is one face of a planar model, 180 the other and +-90 its two sides."""
-    length = float(geometry.centerline_length)
-    s = np.linspace(0.0, length, max(int(length / 5e-4), 2) + 1)
-    points = np.asarray(geometry.centerline_points(s), dtype=float)
+    s, points = centerline_samples(geometry)
     tangents = np.gradient(points, s, axis=0)
     tangents /= np.linalg.norm(tangents, axis=1)[:, None]
     spread = np.linalg.svd(x0 - x0.mean(axis=0), full_matrices=False)[2]
