@@ -181,3 +181,16 @@ def test_the_map_files_keep_every_field(tube, tmp_path):
     assert mesh.cell_data["stretch_max"][0].max() == pytest.approx(1.2, abs=1e-6)
     assert mesh.cell_data["stretch_A"][0].max() == pytest.approx(1.2, abs=1e-6)
     assert mesh.cell_data["stretch_end"][0].max() == pytest.approx(1.1, abs=1e-6)
+
+
+def test_the_surrogate_fits_the_stretched_area():
+    """The column is a surrogate target (``--targets wall_area_stretched_cm2``): a sweep's table
+    carrying it trains a model of it."""
+    from colonsim.surrogate.model import SweepSurrogate
+    from colonsim.surrogate.synthetic import synthetic_sweep
+
+    table = synthetic_sweep(n_runs=30, segments=("rsj",))
+    table[STRETCHED_WALL_COLUMN] = 40.0 * table["final_deformation_cm"]
+    model = SweepSurrogate(targets=(STRETCHED_WALL_COLUMN,), random_state=0).fit(table)
+    cv = model.cv_["rsj"][STRETCHED_WALL_COLUMN]
+    assert cv["n"] == 29 and cv["rmse"] < 0.1 * table[STRETCHED_WALL_COLUMN].std()

@@ -9,6 +9,7 @@ shape: nothing runs again. Matplotlib draws them (Agg, off screen), Pillow write
 
 from __future__ import annotations
 
+import io
 import shutil
 import subprocess
 import warnings
@@ -131,21 +132,31 @@ def animation_frames(result, max_frames=MAX_FRAMES, title=""):
         yield np.asarray(canvas.buffer_rgba())[:, :, :3].copy()
 
 
-def write_animation(result, folder, max_frames=MAX_FRAMES, title="") -> dict:
-    """Write ``folder/insertion.gif`` (and ``insertion.mp4`` when ``ffmpeg`` is on the path); return
-    their paths."""
+def gif_bytes(frames) -> bytes:
+    """The frames as an endlessly looping GIF."""
     from PIL import Image
 
-    frames = list(animation_frames(result, max_frames, title))
-    folder = Path(folder)
-    paths = {"animation": folder / GIF}
     # one palette from the first, middle and last frames for all: quantising each frame on its own
     # took ten times longer and wrote a larger file (measured, docs/visualisation.md)
     palette = Image.fromarray(np.concatenate([frames[0], frames[len(frames) // 2], frames[-1]])).quantize(colors=128)
     images = [Image.fromarray(f).quantize(palette=palette, dither=Image.Dither.NONE) for f in frames]
+    buffer = io.BytesIO()
+    images[0].save(buffer, format="GIF", save_all=True, append_images=images[1:], loop=0,
+                   duration=int(FRAME_SECONDS * 1e3), optimize=True)
+    return buffer.getvalue()
+
+
+def write_animation(result, folder, max_frames=MAX_FRAMES, title="", gif=None) -> dict:
+    """Write ``folder/insertion.gif`` (and ``insertion.mp4`` when ``ffmpeg`` is on the path); return
+    their paths. ``gif``: the GIF already made (:func:`gif_bytes`, by a sweep's worker), written
+    as it is."""
+    folder = Path(folder)
+    paths = {"animation": folder / GIF}
+    frames = None if gif is not None else list(animation_frames(result, max_frames, title))
     with atomic_path(paths["animation"]) as tmp:
-        images[0].save(tmp, format="GIF", save_all=True, append_images=images[1:], loop=0,
-                       duration=int(FRAME_SECONDS * 1e3), optimize=True)
+        tmp.write_bytes(gif if gif is not None else gif_bytes(frames))
+    if frames is None:
+        return paths
     ffmpeg = shutil.which("ffmpeg")
     if ffmpeg is not None:
         movie = write_mp4(ffmpeg, frames, folder / MP4)

@@ -191,11 +191,13 @@ def write_vtu_series(result, folder):
 RUN_SUMMARY, RUN_SERIES, RUN_SHAPE = "summary.json", "timeseries.csv", "final_shape.npz"
 
 
-def write_insertion(result, out_dir, vtu=False, animate=False) -> dict:
+def write_insertion(result, out_dir, vtu=False, animate=False, visuals=None) -> dict:
     """Write the files of one run into ``out_dir``; return their paths. A fresh run (one with its
     model) also gets its wall-stretch map (``stretch_map.npz``, ``stretch_map.png``, with ``vtu``
     ``vtu/colon_stretch.vtu``), and with ``animate`` its movie (``insertion.gif``, needs the run's
-    snapshots)."""
+    snapshots). ``visuals``: the map's arrays and the GIF made where the run ran (a sweep's worker,
+    :func:`colonsim.insertion.study.sweep_worker.ok_outcome`), for a result without its model."""
+    visuals = visuals or {}
     out = Path(out_dir)
     paths = {"timeseries": out / RUN_SERIES, "summary": out / RUN_SUMMARY, "plot": out / "insertion.png"}
     write_csv(paths["timeseries"], user_units(result.timeseries))
@@ -205,7 +207,7 @@ def write_insertion(result, out_dir, vtu=False, animate=False) -> dict:
         paths["final_shape"] = out / RUN_SHAPE
         with atomic_path(paths["final_shape"]) as tmp:
             np.savez_compressed(tmp, **result.final_shape)
-    stretch = map_arrays(result)
+    stretch = visuals.get("stretch_map") if visuals.get("stretch_map") is not None else map_arrays(result)
     if stretch is not None:
         paths["stretch_map"] = write_stretch_map(stretch, out)
         paths["stretch_figure"] = out / STRETCH_FIGURE
@@ -216,10 +218,10 @@ def write_insertion(result, out_dir, vtu=False, animate=False) -> dict:
         paths["vtu"] = out / "vtu"
         if stretch is not None:
             write_stretch_vtu(stretch, result.model.shell.x0, out / "vtu" / "colon_stretch.vtu")
-    if animate:
+    if animate or visuals.get("animation") is not None:
         from colonsim.insertion.case.animation import write_animation
 
-        paths.update(write_animation(result, out, title=run_title(result)))
+        paths.update(write_animation(result, out, title=run_title(result), gif=visuals.get("animation")))
     return paths
 
 
