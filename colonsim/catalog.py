@@ -308,7 +308,8 @@ class Column:
 # The wall counts as stretched where its largest principal stretch over the run passes this
 # (assumption, docs/visualisation.md: 10 % beyond rest, well inside the tissue's failure stretch);
 # a run's own threshold may lie in the range (colonsim insert --stretch-threshold).
-STRETCHED_WALL_COLUMN, STRETCHED_WALL_THRESHOLD, STRETCHED_WALL_THRESHOLD_RANGE = "wall_area_stretched_cm2", 1.1, (1.01, 2.0)
+STRETCHED_WALL_COLUMN = "wall_area_stretched_cm2"
+STRETCHED_WALL_THRESHOLD, STRETCHED_WALL_THRESHOLD_RANGE = 1.1, (1.01, 2.0)
 
 _P, _I, _S, _O = PROVENANCE, INPUT, SETTING, OUTPUT
 COLUMNS = {c.name: c for c in (

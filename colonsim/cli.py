@@ -15,7 +15,6 @@ import warnings
 from pathlib import Path
 
 from colonsim import catalog, cli_material, cli_surrogate, cli_sweep, options
-from colonsim.catalog import STRETCHED_WALL_COLUMN, STRETCHED_WALL_THRESHOLD, STRETCHED_WALL_THRESHOLD_RANGE
 from colonsim.errors import ColonsimError, ColonsimWarning
 from colonsim.files import os_failure
 from colonsim.input_ranges import check_input_range
@@ -165,9 +164,9 @@ def _add_insert(sub):
     p.add_argument("--snapshot-every", type=finite_float, default=0.02,
                    help="simulated seconds between snapshots for --vtu and --animate (default 0.02)")
     p.add_argument("--stretch-threshold", type=finite_float, default=None,
-                   help=f"stretch above which the wall counts as stretched in summary.json's {STRETCHED_WALL_COLUMN} "
-                        f"(default {STRETCHED_WALL_THRESHOLD:g}, {STRETCHED_WALL_THRESHOLD_RANGE[0]:g}-"
-                        f"{STRETCHED_WALL_THRESHOLD_RANGE[1]:g}; an assumption)")
+                   help=f"stretch above which the wall counts as stretched in summary.json's "
+                        f"{catalog.STRETCHED_WALL_COLUMN} (default {catalog.STRETCHED_WALL_THRESHOLD:g}, "
+                        "{:g}-{:g}; an assumption)".format(*catalog.STRETCHED_WALL_THRESHOLD_RANGE))
     p.add_argument("--threads", type=int, default=None,
                    help="Numba threads (default: all cores). Use 1 when running several insertions side by side: "
                         "oversubscribed threads slow the kernels down by an order of magnitude")

@@ -176,7 +176,7 @@ def write_mp4(ffmpeg, frames, path):
         done = subprocess.run(command, input=b"".join(f.tobytes() for f in frames), capture_output=True)
     if done.returncode != 0:  # the movie is extra: the run's other files are kept
         path.unlink(missing_ok=True)
-        warnings.warn(f"ffmpeg could not write {path.name} ({' '.join(done.stderr.decode(errors='replace').split())[:200]}); "
-                      "the GIF is written", ColonsimWarning)
+        said = " ".join(done.stderr.decode(errors="replace").split())[:200]
+        warnings.warn(f"ffmpeg could not write {path.name} ({said}); the GIF is written", ColonsimWarning)
         return None
     return path
