@@ -308,6 +308,12 @@ class Column:
                                 "with a label; fix the entry in colonsim/catalog.py")
 
 
+# The wall counts as stretched where its largest principal stretch over the run passes this
+# (assumption, docs/visualisation.md: 10 % beyond rest, well inside the tissue's failure stretch);
+# a run's own threshold may lie in the range (colonsim insert --stretch-threshold).
+STRETCHED_WALL_COLUMN = "wall_area_stretched_cm2"
+STRETCHED_WALL_THRESHOLD, STRETCHED_WALL_THRESHOLD_RANGE = 1.1, (1.01, 2.0)
+
 _P, _I, _S, _O = PROVENANCE, INPUT, SETTING, OUTPUT
 COLUMNS = {c.name: c for c in (
     Column("key", _P, "", "hash of every input: identifies the run"),
@@ -394,6 +400,9 @@ COLUMNS = {c.name: c for c in (
            "peak push force [N]"),
     Column("max_wall_stretch", _O, "", "largest wall stretch over the run", DEFAULT_TARGET,
            "maximum wall stretch"),
+    Column(STRETCHED_WALL_COLUMN, _O, "cm2", f"wall area (rest configuration) whose largest principal stretch over the "
+                                             f"run passed {STRETCHED_WALL_THRESHOLD:g} (an assumption: a candidate pain "
+                                             "measure; docs/visualisation.md)", TARGET, "stretched wall area [cm2]"),
     Column("ringing_ratio", _O, "", "RMS of the push force about its 1 cm moving average over max(its mean, 1 N), over "
                                     "the push from the first contact, the 6 mm after each snap-through left out "
                                     "(docs/quasi_static.md)"),

@@ -115,8 +115,9 @@ def _add_insert(sub):
     p = sub.add_parser("insert", help="simulate a colonoscope insertion (explicit dynamics)",
                        description="Push a colonoscope through a colon model (docs/model.md) and record the colon "
                                    "deformation, contact and push forces, tip motion and energies. Writes "
-                                   "timeseries.csv, summary.json and insertion.png per scope, a comparison table "
-                                   "and figure, and optional VTU files for ParaView.")
+                                   "timeseries.csv, summary.json, insertion.png and the wall-stretch map "
+                                   "(stretch_map.npz/.png) per scope, a comparison table and figure, and optional "
+                                   "movies (--animate) and VTU files for ParaView.")
     p.add_argument("--segment", default=None, help=f"colon model (default rsj): {options.segment_help()}")
     p.add_argument("--scope", nargs="+", default=["sdc"], help=f"{options.scope_help()}; several allowed (default sdc)")
     p.add_argument("--centerline", type=Path,
@@ -157,8 +158,15 @@ def _add_insert(sub):
                    help="N the colon beyond the model opposes to the tip's advance once it is in the fixed exit "
                         "(default 5, the light level of 0/5/10/20; 0: none; docs/model.md, \"Loading\")")
     p.add_argument("--vtu", action="store_true", help="write deformed meshes for ParaView (needs meshio)")
+    p.add_argument("--animate", action="store_true",
+                   help="write insertion.gif per run (insertion.mp4 too when ffmpeg is on the path): the wall coloured "
+                        "by displacement, the scope, the push force (docs/visualisation.md)")
     p.add_argument("--snapshot-every", type=options.ranged("--snapshot-every"), default=0.02,
-                   help="simulated seconds between VTU snapshots (0.001-10, with --vtu)")
+                   help="simulated seconds between snapshots for --vtu and --animate (0.001-10, default 0.02)")
+    p.add_argument("--stretch-threshold", type=finite_float, default=None,
+                   help=f"stretch above which the wall counts as stretched in summary.json's "
+                        f"{catalog.STRETCHED_WALL_COLUMN} (default {catalog.STRETCHED_WALL_THRESHOLD:g}, "
+                        "{:g}-{:g}; an assumption)".format(*catalog.STRETCHED_WALL_THRESHOLD_RANGE))
     p.add_argument("--threads", type=int, default=None,
                    help="Numba threads (default: all cores). Use 1 when running several insertions side by side: "
                         "oversubscribed threads slow the kernels down by an order of magnitude")
@@ -179,6 +187,10 @@ def cmd_insert(args):
         from colonsim.insertion.case.results import check_vtu_writer
 
         check_vtu_writer()
+    if args.stretch_threshold is not None:
+        from colonsim.insertion.case.stretch_map import check_threshold
+
+        check_threshold(args.stretch_threshold)
     if args.threads is not None:
         if not 1 <= args.threads <= numba.config.NUMBA_NUM_THREADS:
             raise ColonsimError(f"--threads {args.threads} must lie in 1-{numba.config.NUMBA_NUM_THREADS} (the cores Numba sees)")
@@ -204,7 +216,7 @@ def cmd_insert(args):
     from colonsim.workflows import insert
 
     insert(cases, args.out, vtu=args.vtu, snapshot_every=args.snapshot_every, show=not args.no_progress,
-                   max_steps=args.max_steps)
+           max_steps=args.max_steps, animate=args.animate, stretch_threshold=args.stretch_threshold)
 
 
 class OneLineParser(argparse.ArgumentParser):

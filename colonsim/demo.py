@@ -1,7 +1,8 @@
 """``colonsim demo``: the three workflows end to end on the bundled data, in a few minutes on 2 cores.
 
 1. calibrate Mooney-Rivlin parameters from the bundled SYNTHETIC tensile curves (reduced budget);
-2. RSJ insertions of UTC, PDC and SDC (D = 36 mm, mu = 0) with the material just calibrated;
+2. RSJ insertions of UTC, PDC and SDC (D = 36 mm, mu = 0) with the material just calibrated,
+   each with its wall-stretch map, the SDC run also as a movie (``insertion.gif``);
 3. a small sweep: RSJ x 3 scopes x D 23/36 mm x mu 0/0.1 (12 runs on local processes, three of
    which are step 2's runs, recorded rather than run again), and 4 of its cases again on a finer
    mesh (the simulation's scatter);
@@ -110,7 +111,7 @@ def insertion_step(material: Path, size: dict, out: Path, show: bool):
     # the material named as the sweep names it, so that these three runs are cases of the sweep
     cases = [InsertionCase(segment="rsj", scope=s, diameter_mm=36.0, material=material.resolve().as_posix(), **size)
              for s in ("utc", "pdc", "sdc")]
-    return insert(cases, out, show=show)
+    return insert(cases, out, show=show, animate={cases[-1].key()})  # the movie of the standard scope's run
 
 
 def record_step_runs(spec, insertions, out: Path) -> int:
@@ -211,7 +212,10 @@ def write_report(out: Path, calibration, insertions, sweep, model, recs, seconds
     from colonsim.insertion.case.results import comparison_table
     from colonsim.surrogate.recommend import format_recommendation
 
+    from colonsim.workflows import run_folder
+
     sd = dict(zip(calibration.names, calibration.uncertainty.std))
+    animated = run_folder(insertions[-1])  # the run step 2 animates
     speed = (f", pushed at {size['push_speed']:g} m/s (not the model's quasi-static default: faster and cheaper, "
              "its numbers ring)" if "push_speed" in size else "")
     lines = ["# colonsim demo", "",
@@ -228,6 +232,11 @@ def write_report(out: Path, calibration, insertions, sweep, model, recs, seconds
               "## 2. RSJ insertions, D = 36 mm, mu = 0 (`insertion/`)", "",
               frame_table(comparison_table(insertions), _cell), "",
               "![RSJ insertions](insertion/comparison.png)", "",
+              f"The {insertions[-1].summary['scope']['name']} run as a movie (`insertion/{animated}/insertion.gif`) "
+              "and where it stretched the wall, unrolled (`stretch_map.png` in every run's folder; "
+              "docs/visualisation.md):", "",
+              f"![the {insertions[-1].summary['scope']['name']} insertion](insertion/{animated}/insertion.gif)", "",
+              f"![wall-stretch map](insertion/{animated}/stretch_map.png)", "",
               "## 3. Sweep (`sweep/`)", "",
               f"{sweep.total} runs, {int((sweep.table['status'] == 'ok').sum())} ok. "
               "Table: `sweep/results.parquet`; time series: `sweep/runs/<key>/`; four of its cases on a finer mesh, "

@@ -316,30 +316,45 @@ def anatomy_inputs(segment, centerline, diameter_mm, smoothing_mm) -> dict:
             "centerline_smoothing_mm": smoothing, "diameter_mm": diameter_mm}
 
 
-def insert(cases, out: Path, vtu=False, snapshot_every=0.02, show=True, max_steps=DEFAULT_MAX_STEPS):
+def insert(cases, out: Path, vtu=False, snapshot_every=0.02, show=True, max_steps=DEFAULT_MAX_STEPS, animate=False,
+           stretch_threshold=None):
     """Run each case, write its folder under ``out`` and a comparison; return the results.
 
     Every case is checked first, its run time estimated included (:mod:`colonsim.insertion.case.run_budget`):
-    a case needing more than ``max_steps`` time steps is refused before any run starts."""
+    a case needing more than ``max_steps`` time steps is refused before any run starts. ``animate``:
+    write the movie of every run (True) or of the cases whose keys it holds; ``stretch_threshold``:
+    the stretch above which the summaries count the wall as stretched (None: the catalog's)."""
     from colonsim.files import output_set
     from colonsim.insertion.case.run_budget import check_run_budget
+    from colonsim.insertion.case.stretch_map import check_threshold
 
+    if stretch_threshold is not None:
+        check_threshold(stretch_threshold)
     budgets = [check_run_budget(case, max_steps) for case in cases]
+    animated = {c.key() for c in cases} if animate is True else set(animate or ())
     with output_set(out, files=("comparison.csv", "comparison.png")) as stage:  # swapped in when all are written
-        results = _run_cases(cases, budgets, out, stage, vtu, snapshot_every, show)
+        results = _run_cases(cases, budgets, out, stage, (vtu, snapshot_every, animated, stretch_threshold), show)
     print(f"comparison: {out}/comparison.csv, {out}/comparison.png")
     return results
 
 
-def _run_cases(cases, budgets, out, stage, vtu, snapshot_every, show):
-    """Run ``cases`` and write their folders and the comparison into ``stage`` (what becomes ``out``)."""
+def run_folder(result) -> str:
+    """The name of a run's folder under ``insert``'s output folder: model and scope (``rsj_SDC``)."""
+    return f"{result.case.segment}_{result.summary['scope']['name'].replace(' ', '')}"
+
+
+def _run_cases(cases, budgets, out, stage, outputs, show):
+    """Run ``cases`` and write their folders and the comparison into ``stage`` (what becomes
+    ``out``); ``outputs``: VTU files, snapshot interval, keys of the cases animated, stretch threshold."""
     from tqdm import tqdm
 
     from colonsim.files import save_figure, write_csv
     from colonsim.insertion.case.results import (comparison_table, distal_words, insertion_figure, quasi_static_words,
                                               relax_words, rest_words, write_insertion)
     from colonsim.insertion.case.scenario import run_insertion
+    from colonsim.insertion.case.stretch_map import restate_threshold
 
+    vtu, snapshot_every, animated, stretch_threshold = outputs
     results = []
     for case, budget in zip(cases, budgets):
         print(f"{case.segment.upper()} {case.scope.upper()}: {budget.describe()}", flush=True)
@@ -353,11 +368,14 @@ def _run_cases(cases, budgets, out, stage, vtu, snapshot_every, show):
             bar.set_postfix_str(f"tip {100 * tip_arc:.1f}/{100 * tip_end:.1f} cm", refresh=False)
 
         try:
-            r = run_insertion(case, progress=progress, snapshot_interval=snapshot_every if vtu else None)
+            animate = case.key() in animated
+            r = run_insertion(case, progress=progress, snapshot_interval=snapshot_every if vtu or animate else None)
         finally:
             bar.close()
-        name = f"{case.segment}_{r.summary['scope']['name'].replace(' ', '')}"
-        write_insertion(r, stage / name, vtu=vtu)
+        if stretch_threshold is not None:
+            restate_threshold(r.summary, r, stretch_threshold)
+        name = run_folder(r)
+        write_insertion(r, stage / name, vtu=vtu, animate=animate)
         folder = out / name
         results.append(r)
         s = r.summary

@@ -60,5 +60,11 @@ def test_demo_runs_every_workflow_and_writes_one_folder(tmp_path, capsys):
             f"{SMOKE_PUSH_SPEED:g} m/s") in report
     assert set(table["push_speed"]) == set(replicates["push_speed"]) == {SMOKE_PUSH_SPEED}
     assert "![RSJ insertions](insertion/comparison.png)" in report
-    for figure in ("insertion/comparison.png", "surrogate_vs_diameter_mm.png", "surrogate_vs_friction.png"):
+    for figure in ("insertion/comparison.png", "surrogate_vs_diameter_mm.png", "surrogate_vs_friction.png",
+                   "insertion/rsj_SDC/insertion.gif", "insertion/rsj_SDC/stretch_map.png"):
         assert (out / figure).stat().st_size > 10_000
+    # the SDC run is the one animated, every run has its stretch map, the sweep its stretched area
+    assert "![the SDC insertion](insertion/rsj_SDC/insertion.gif)" in report
+    assert not (out / "insertion" / "rsj_UTC" / "insertion.gif").exists()
+    assert (out / "insertion" / "rsj_UTC" / "stretch_map.npz").is_file()
+    assert (table["wall_area_stretched_cm2"] > 0).all()

@@ -13,6 +13,9 @@ without one), contact_force_N (sum of normal contact forces),
 push_force_N (drive reaction along the sheath axis), contact_nodes, kinetic/internal energy
 of each body (J), kinetic_scope_sliding_J (the scope's kinetic energy relative to sliding along
 itself at the push speed, :func:`colonsim.insertion.case.outcomes.sliding_kinetic_energy`), contact_energy_J, dt_s, step.
+
+Beside the rows: snapshots of the wall and the scope (with a snapshot interval: VTU files, the
+animation) and the wall-stretch record (:class:`colonsim.insertion.case.stretch_map.WallStretch`).
 """
 
 from __future__ import annotations
@@ -22,6 +25,7 @@ import pandas as pd
 
 from colonsim.insertion.case.outcomes import (JAM_PUSH, arc_along, jammed, principal_stretches,
                                              sliding_kinetic_energy, tip_heading)
+from colonsim.insertion.case.stretch_map import WallStretch, attach
 
 
 class InsertionRecorder:
@@ -35,12 +39,12 @@ class InsertionRecorder:
         self._next_snapshot = 0.0
         g = model.geometry
         self._mobile = model.mobile_nodes
-        # held triangles stay at rest (stretch 1): the largest stretch is that of the others
+        # held triangles stay at rest (stretch 1): the largest stretch is that of the others, and
+        # the wall-stretch map keeps each one's largest over the run from the same measurement
         held = np.zeros(len(model.shell.x0), dtype=bool)
         held[model.fixed_nodes] = True
-        moving = ~held[model.shell.triangles].all(axis=1)
-        self._triangles = model.shell.triangles[moving] if moving.any() else model.shell.triangles[:1]
-        self._dm_inv = model.shell.dm_inv[moving] if moving.any() else model.shell.dm_inv[:1]
+        self.wall = WallStretch(model.shell.triangles, model.shell.dm_inv, held)
+        attach(model, self.wall)
         self._tip = model.rod.tip_node
         self._tip0 = model.rod.x0[self._tip].copy()
         s = np.linspace(0.0, g.centerline_length, max(200, int(g.centerline_length / 1e-3)))
@@ -65,13 +69,15 @@ class InsertionRecorder:
         tip = scope.x[self._tip]
         depth = m.push.depth(solver.time)
         tip_arc = float(arc_along(self._arc_points, self._arc, self._arc_tangents, tip))
+        stretches = principal_stretches(colon.x, self.wall.triangles, self.wall.dm_inv)
+        self.wall.sample(stretches, deformation, colon.f_con)
         row = {
             "time_s": solver.time,
             "step": solver.step,
             "dt_s": solver.dt,
             "depth_m": depth,
             "deformation_m": deformation,
-            "max_stretch": float(principal_stretches(colon.x, self._triangles, self._dm_inv).max()),
+            "max_stretch": float(stretches.max()),
             "tip_displacement_m": float(np.linalg.norm(tip - self._tip0)),
             "tip_arc_m": tip_arc,
             "tip_past_end_m": float(np.dot(tip - self._end_point, self._end_axis)),

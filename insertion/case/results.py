@@ -8,7 +8,10 @@ Layout of a run folder::
     insertion.png    deformation vs depth, forces, energy ratio, tip displacement
     final_shape.npz  wall and scope node positions at the end of the run, m (``colon_m``, ``scope_m``;
                      read with :func:`read_final_shape`; the rest shape follows from the inputs)
-    vtu/             colon_NNNN.vtu, scope_NNNN.vtu (+ .pvd collections) with --vtu
+    stretch_map.npz  per wall triangle its largest stretch over the run, at A, C and the end, with
+                     the unrolled mesh (:mod:`colonsim.insertion.case.stretch_map`); stretch_map.png
+    insertion.gif    the movie of the run with --animate (insertion.mp4 too when ffmpeg is on the path)
+    vtu/             colon_NNNN.vtu, scope_NNNN.vtu (+ .pvd collections), colon_stretch.vtu with --vtu
 """
 
 from __future__ import annotations
@@ -19,10 +22,14 @@ import numpy as np
 import pandas as pd
 from matplotlib.figure import Figure
 
-from colonsim.catalog import TIP_FOLDED
+from colonsim.catalog import STRETCHED_WALL_COLUMN, STRETCHED_WALL_THRESHOLD, TIP_FOLDED
 from colonsim.files import atomic_path, save_figure, write_csv, write_json
 from colonsim.insertion.case.outcomes import REST_WINDOW
 from colonsim.insertion.case.ringing import RINGING_LIMIT
+from colonsim.insertion.case.stretch_figure import stretch_map_figure
+from colonsim.insertion.case.stretch_map import map_arrays, write_stretch_map, write_stretch_vtu
+
+STRETCH_FIGURE = "stretch_map.png"
 
 
 def user_units(ts: pd.DataFrame) -> pd.DataFrame:
@@ -106,6 +113,7 @@ def comparison_table(results) -> pd.DataFrame:
                            "peak_contact_force_N": r.summary["peak_contact_force_N"],
                            "peak_push_force_N": r.summary["peak_push_force_N"],
                            "max_wall_stretch": r.summary["max_wall_stretch"],
+                           STRETCHED_WALL_COLUMN: r.summary.get(STRETCHED_WALL_COLUMN),
                            "max_lag_cm": r.summary["max_lag_cm"], "final_lag_cm": r.summary["final_lag_cm"],
                            "tip_turned_back_cm": r.summary.get("tip_turned_back_cm"),
                            "ringing_ratio": r.summary["quasi_static"]["ringing_ratio"],
@@ -191,8 +199,13 @@ def write_vtu_series(result, folder):
 RUN_SUMMARY, RUN_SERIES, RUN_SHAPE = "summary.json", "timeseries.csv", "final_shape.npz"
 
 
-def write_insertion(result, out_dir, vtu=False) -> dict:
-    """Write the files of one run into ``out_dir``; return their paths."""
+def write_insertion(result, out_dir, vtu=False, animate=False, visuals=None) -> dict:
+    """Write the files of one run into ``out_dir``; return their paths. A fresh run (one with its
+    model) also gets its wall-stretch map (``stretch_map.npz``, ``stretch_map.png``, with ``vtu``
+    ``vtu/colon_stretch.vtu``), and with ``animate`` its movie (``insertion.gif``, needs the run's
+    snapshots). ``visuals``: the map's arrays and the GIF made where the run ran (a sweep's worker,
+    :func:`colonsim.insertion.study.sweep_worker.ok_outcome`), for a result without its model."""
+    visuals = visuals or {}
     out = Path(out_dir)
     paths = {"timeseries": out / RUN_SERIES, "summary": out / RUN_SUMMARY, "plot": out / "insertion.png"}
     write_csv(paths["timeseries"], user_units(result.timeseries))
@@ -202,10 +215,28 @@ def write_insertion(result, out_dir, vtu=False) -> dict:
         paths["final_shape"] = out / RUN_SHAPE
         with atomic_path(paths["final_shape"]) as tmp:
             np.savez_compressed(tmp, **result.final_shape)
+    stretch = visuals.get("stretch_map") if visuals.get("stretch_map") is not None else map_arrays(result)
+    if stretch is not None:
+        paths["stretch_map"] = write_stretch_map(stretch, out)
+        paths["stretch_figure"] = out / STRETCH_FIGURE
+        threshold = result.summary.get("wall_stretch", {}).get("threshold", STRETCHED_WALL_THRESHOLD)
+        save_figure(stretch_map_figure(stretch, threshold, run_title(result)), paths["stretch_figure"])
     if vtu:
         write_vtu_series(result, out / "vtu")
         paths["vtu"] = out / "vtu"
+        if stretch is not None:
+            write_stretch_vtu(stretch, result.model.shell.x0, out / "vtu" / "colon_stretch.vtu")
+    if animate or visuals.get("animation") is not None:
+        from colonsim.insertion.case.animation import write_animation
+
+        paths.update(write_animation(result, out, title=run_title(result), gif=visuals.get("animation")))
     return paths
+
+
+def run_title(result) -> str:
+    """A run named for figures: model, scope, colon diameter."""
+    angle = f" {result.case.angle_deg:g} deg" if result.case.angle_deg else ""
+    return f"{result.case.segment.upper()}{angle}, {result.summary['scope']['name']}, D {result.case.diameter_mm:g} mm"
 
 
 def read_final_shape(out_dir) -> dict:

@@ -12,6 +12,7 @@ from colonsim.insertion.case.outcomes import (JAM_FORCE, JAM_PROGRESS, JAM_PUSH,
 from colonsim.insertion.case.ringing import (RINGING_FORCE_FLOOR_N, RINGING_LIMIT, RINGING_WINDOW, SNAP_DROP_N,
                                              SNAP_DROP_PUSH, SNAP_DROP_SHARE, SNAP_LEFT_OUT_LIMIT, SNAP_LEFT_OUT_PUSH,
                                              ringing_cause, ringing_holds, ringing_ratio)
+from colonsim.insertion.case.stretch_map import wall_stretch_summary
 from colonsim.insertion.engine.material import REFERENCE_MATERIAL_PATH
 from colonsim.provenance import code_version
 
@@ -145,4 +146,5 @@ def summarize(model, ts, wall_s, build_s) -> dict:
         "mesh": {**g.summary(), "scope_nodes": int(model.rod.n_nodes), "hinges": int(len(model.shell.hinges))},
         "material": {"law": model.shell.material.law, **model.shell.material.named_parameters,
                      "file": model.case.material or str(REFERENCE_MATERIAL_PATH)},
+        **wall_stretch_summary(model, ts),  # where the wall is stretched (stretch_map.py)
     }

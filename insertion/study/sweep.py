@@ -42,6 +42,7 @@ from colonsim.schemas import check_run_folders, check_sweep_document
 from colonsim.insertion.case.results import RUN_SUMMARY
 from colonsim.insertion.case.run_budget import DEFAULT_MAX_STEPS, check_sweep_budget
 from colonsim.insertion.case.scenario import InsertionResult
+from colonsim.insertion.study.sweep_animation import AnimatedRuns
 from colonsim.insertion.study.sweep_outcomes import dask_distributed, dask_outcomes, local_outcomes
 from colonsim.insertion.study.sweep_rows import IDENTITY, OUTPUTS, input_columns, input_row, result_row
 from colonsim.insertion.study.sweep_table import read_table
@@ -161,7 +162,7 @@ class SweepStore:
             result = InsertionResult(case, outcome["timeseries"], outcome["summary"], snapshots=[], model=None,
                                      final_shape=outcome.get("final_shape"))
             with output_set(self.folder / "runs") as stage:  # the run's folder whole, or its earlier one kept
-                written = write_insertion(result, stage / case.key())
+                written = write_insertion(result, stage / case.key(), visuals=outcome.get("visuals"))
             path = (folder / written["timeseries"].name).as_posix()
         row = result_row(case, outcome, path)
         self.rows[row["key"]] = row
@@ -284,6 +285,8 @@ def run_sweep(cases, out, workers=2, scheduler=None, runner=None, retry_failed=F
     out = check_output_folder(out)
     check_entries(out, {TABLE: "file", SWEEP_DOCUMENT: "file", "runs": "folder"})  # before any run, not after
     check_sweep_budget(cases, max_steps)
+    if runner is None and spec is not None and spec.animated:  # the chosen runs with snapshots and their movie
+        runner = AnimatedRuns(spec.animated)
     t0 = time.perf_counter()
     with SweepStore(out) as store:
         extends = store.check_same_sweep([c.key() for c in cases], spec.source if spec is not None else None)

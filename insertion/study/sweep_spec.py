@@ -7,6 +7,7 @@ Format (every key of ``[fixed]``, ``[[grid]]`` and ``[lhs]`` is a field of
     name = "rsj-scopes"          # names the default output folder
     seed = 1                     # seed of the Latin hypercube (default 0)
     description = "..."          # optional, free text
+    animate = [{scope = "sdc", diameter_mm = 36}]   # optional: the runs whose movie is written (true: all)
 
     [fixed]                      # the same value in every case
     element_size_mm = 4.0
@@ -68,6 +69,7 @@ from colonsim.inputs import check_input, read_input_text
 from colonsim.limits import MAX_RUNS  # re-exported: the bound the sweep docs name
 from colonsim.insertion.case.scenario import InsertionCase
 from colonsim.insertion.study.material_samples import MATERIAL_PARAMETERS, sample_materials
+from colonsim.insertion.study.sweep_animation import animated_keys
 from colonsim.insertion.study.sweep_presets import PRESETS  # re-exported: the presets load_sweep knows
 
 if sys.version_info >= (3, 11):
@@ -77,7 +79,7 @@ else:  # pragma: no cover
 
 SCOPE_DIAMETER = "scope_diameter_mm"
 SECTIONS = ("sweep", "fixed", "grid", "lhs", "material")
-SWEEP_KEYS = ("name", "seed", "description")
+SWEEP_KEYS = ("name", "seed", "description", "animate")
 LHS_DECIMALS = 3
 # Wall time of one run on one core: the thesis preset on the 2-core development machine (README):
 # RSJ 5-17 s, RSF 45-120 s, THF 50-260 s at the default mesh.
@@ -94,6 +96,7 @@ class SweepSpec:
     cases: list = field(default_factory=list)
     source: str = ""
     lhs_ranges: list = field(default_factory=list)  # [(key, low, high)] of [lhs], in its order (adaptive sweeps)
+    animated: frozenset = frozenset()  # keys of the cases whose movie is written ([sweep] animate)
 
     def document(self) -> dict:
         """A JSON-able description (written next to the results)."""
@@ -320,7 +323,14 @@ def parse_sweep(text: str, base: Path | None = None, origin: str = "sweep") -> S
     cases = sample_materials(doc, cases, base, seed, MAX_RUNS)
     _check_materials(cases)
     return SweepSpec(name=name.strip(), seed=seed, description=str(head.get("description", "")), cases=cases,
-                     source=text, lhs_ranges=lhs_ranges)
+                     source=text, lhs_ranges=lhs_ranges,
+                     animated=animated_keys(head.get("animate", False), cases, lambda k, v: _chosen(k, v, base)))
+
+
+def _chosen(key, value, base):
+    """One input of an ``animate`` table, checked and read as the grid reads it."""
+    _axis_keys({key: value}, "sweep] animate = [{...}")
+    return _coerce(key, value, "[sweep] animate", base)
 
 
 def _check_size(origin, grid_sizes, lhs):

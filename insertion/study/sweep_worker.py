@@ -36,10 +36,15 @@ def utc_now() -> str:
 
 
 def ok_outcome(result) -> dict:
-    """The outcome fields of a run that finished (``result``: ``.summary``, ``.timeseries`` and an
-    optional ``.final_shape``), as the sweep's store records them."""
+    """The outcome fields of a run that finished (``result``: ``.summary``, ``.timeseries``, an
+    optional ``.final_shape`` and, from a run with its model, the wall-stretch map's arrays and an
+    optional movie, :mod:`colonsim.insertion.study.sweep_animation`), as the sweep's store records them."""
+    from colonsim.insertion.case.stretch_map import map_arrays
+
+    visuals = {"stretch_map": map_arrays(result) if getattr(result, "model", None) is not None else None,
+               "animation": getattr(result, "animation_gif", None)}
     return {"status": "ok", "error": "", "summary": result.summary, "timeseries": result.timeseries,
-            "final_shape": getattr(result, "final_shape", None)}
+            "final_shape": getattr(result, "final_shape", None), "visuals": visuals}
 
 
 def warm_up_case():
