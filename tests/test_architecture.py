@@ -27,7 +27,7 @@ LAYERS = {
     "colonsim.errors": GROUND, "colonsim.files": GROUND, "colonsim.provenance": GROUND,
     "colonsim.markdown": GROUND, "colonsim.data": GROUND, "colonsim.catalog": GROUND, "colonsim.laws": GROUND,
     "colonsim.inputs": GROUND, "colonsim.limits": GROUND, "colonsim.scheduler_address": GROUND,
-    "colonsim.input_ranges": GROUND, "colonsim.schemas": GROUND,
+    "colonsim.input_ranges": GROUND, "colonsim.result_columns": GROUND, "colonsim.schemas": GROUND,
     "colonsim.insertion": PHYSICS,
     "colonsim.insertion.engine": PHYSICS,
     "colonsim.insertion.anatomy": ANATOMY,

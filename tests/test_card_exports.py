@@ -163,8 +163,9 @@ def test_per_specimen_fits_leave_the_folders_cards_alone(tmp_path):
     ({"law": "yeoh", "units": "Pa", "parameters": {"C10": float("nan"), "C20": 0.0, "C30": 0.0}}, "parameter C10 is nan"),
     ({"law": "yeoh", "units": "Pa", "parameters": {"C10": -1e5, "C20": 0.0, "C30": 0.0}},
      "initial shear modulus -200000 Pa is not positive"),
-    ({"law": "yeoh", "units": "Pa", "parameters": {"C10": "1e5", "C20": 0.0, "C30": 0.0}}, "parameter C10 is '1e5', not a number"),
-    ({"law": "yeoh", "units": "kPa", "parameters": YEOH}, "lacks the parameters C10, C20, C30 in Pa")])
+    ({"law": "yeoh", "units": "Pa", "parameters": {"C10": "1e5", "C20": 0.0, "C30": 0.0}}, "parameter C10 is '1e5', not a finite number"),
+    ({"law": "yeoh", "units": "kPa", "parameters": YEOH}, "has no parameters in Pa"),
+    ({"law": "yeoh", "units": "Pa", "parameters": {"C10": 1e5, "C20": 0.0}}, "parameter C30 is None, not a finite number")])
 def test_a_material_file_no_card_can_hold_is_refused(tmp_path, capsys, doc, message):
     material = tmp_path / "material.json"
     material.write_text(json.dumps(doc))

@@ -97,13 +97,14 @@ def key_without(case, *names):
 
 def test_zero_resistance_builds_no_resistance_and_keeps_the_key_of_before():
     case = InsertionCase(segment="rsf", angle_deg=45.0, element_size_mm=COARSE_MM, distal_resistance_N=0.0,
-                         relax_max_s=0.0)  # the relax of before: relax_s alone
+                         relax_max_s=0.0, time_step_estimate="bounds")  # the relax and the time step of before
     assert build_insertion(case).resistance is None
     # the runs of before lacked the first five and the last; the three between stay out at their defaults
     assert case.key() == key_without(case, "distal_resistance_N", "failure_stretch", "held_push_share",
                                      "held_push_lead_mm", "relax_max_s",
                                      "centerline", "centerline_smoothing_mm", "material_parameters",
-                                     "time_step_estimate", "contact_surface", "contact_face_subdivision")
+                                     "time_step_estimate", "contact_surface", "contact_face_subdivision",
+                                     "stiffness_factor")
     assert InsertionCase(distal_resistance_N=5.0).key() != InsertionCase(distal_resistance_N=0.0).key()
 
 
@@ -141,12 +142,12 @@ def test_a_held_push_lead_outside_its_range_is_refused_in_one_line(value):
 def test_a_held_push_lead_enters_the_key_only_where_a_resistance_holds_the_tip():
     # 50 mm by default (2026-11-28); at 0, the runs of before, it stays out of the key
     assert InsertionCase(held_push_lead_mm=50.0).key() == InsertionCase().key()
-    before = InsertionCase(held_push_lead_mm=0.0)
+    before = InsertionCase(held_push_lead_mm=0.0, time_step_estimate="bounds")
     assert before.key() != InsertionCase().key()
     assert before.key() == key_without(before, "held_push_lead_mm", "relax_max_s",  # no relax in the RSJ
                                        "centerline", "centerline_smoothing_mm", "material_parameters",
                                        "failure_stretch", "time_step_estimate", "contact_surface",
-                                       "contact_face_subdivision")
+                                       "contact_face_subdivision", "stiffness_factor")
     # nothing holds the tip: the lead does nothing and stays out
     free = InsertionCase(distal_resistance_N=0.0)
     assert InsertionCase(distal_resistance_N=0.0, held_push_lead_mm=0.0).key() == free.key()

@@ -120,8 +120,11 @@ def test_every_case_is_crossed_with_every_draw(tmp_path):
     # with the held push (held_push_share 0.5 behind a tip the distal resistance holds), and with the
     # 0.15 m/s push, and with the defaults of 2026-11-28 (the held push 50 mm before the exit, the
     # relax until at rest, the shortest closing hold 0.5 s)
-    assert InsertionCase().key() == "d1aafd84d442"
-    assert InsertionCase(segment="rsf", scope="utc", angle_deg=30, friction=0.05).key() == "cbf520e7eee8"
+    assert InsertionCase(time_step_estimate="bounds").key() == "d1aafd84d442"  # ... and at the global time-step
+    assert InsertionCase().key() == "fecd8bb9070e"  # estimate, the default since 2026-12-07 (the bounds' keep theirs)
+    assert InsertionCase(segment="rsf", scope="utc", angle_deg=30, friction=0.05,
+                         time_step_estimate="bounds").key() == "cbf520e7eee8"
+    assert InsertionCase(segment="rsf", scope="utc", angle_deg=30, friction=0.05).key() == "7e90c80d1d57"
 
 
 def test_population_uses_each_specimen_once_or_a_seeded_subset(tmp_path):

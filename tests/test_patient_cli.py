@@ -89,8 +89,11 @@ def test_a_patient_runs_from_the_command_line(files, capsys):
 
 
 def test_case_checks_and_keys(files):
-    assert InsertionCase().key() == "d1aafd84d442"  # the quasi-static defaults (0.15 m/s), the 5 N distal resistance, the held push and the end at rest, the defaults of 2026-11-28; see test_material_samples
-    assert InsertionCase(segment="rsf", scope="utc", angle_deg=30, friction=0.05).key() == "cbf520e7eee8"
+    assert InsertionCase(time_step_estimate="bounds").key() == "d1aafd84d442"  # ... and at the global time-step
+    assert InsertionCase().key() == "fecd8bb9070e"  # estimate, the default since 2026-12-07 (the bounds' keep theirs)  # the quasi-static defaults (0.15 m/s), the 5 N distal resistance, the held push and the end at rest, the defaults of 2026-11-28; see test_material_samples
+    assert InsertionCase(segment="rsf", scope="utc", angle_deg=30, friction=0.05,
+                         time_step_estimate="bounds").key() == "cbf520e7eee8"
+    assert InsertionCase(segment="rsf", scope="utc", angle_deg=30, friction=0.05).key() == "7e90c80d1d57"
     with pytest.raises(ColonsimError, match="use segment 'patient'"):
         InsertionCase(segment="rsj", centerline=str(files / "good.csv")).validate()
     case = InsertionCase(segment="patient", centerline=str(files / "good.csv"), scope="utc")

@@ -81,7 +81,7 @@ def test_smoke_sweep_on_a_dask_local_cluster(tmp_path):
     assert len(table) == 3 and set(table["key"]) == {c.key() for c in SMOKE}
     assert set(CONTRACT) <= set(table.columns)
     assert list(table.columns) == [*IDENTITY, *(f.name for f in dataclasses.fields(InsertionCase)),
-                                   "scope_diameter_mm", "wall_mu0_kPa", "wall_C11_kPa", *OUTPUTS]
+                                   "scope_diameter_mm", "wall_mu0_kPa", "wall_C11_kPa", "tissue_stiffness", *OUTPUTS]
     assert table["quasi_static"].dtype == bool and sorted(table["scope_diameter_mm"]) == [9.2, 11.3, 12.8]
     check_ok_rows(out, table)
     # nothing left to do: the same sweep is skipped entirely, without a cluster

@@ -19,7 +19,15 @@ import sweep_records as records  # noqa: E402
 from validation_sweeps import Sweep  # noqa: E402
 
 from colonsim.errors import ColonsimError  # noqa: E402
+from colonsim.insertion.case.insertion_case import InsertionCase  # noqa: E402
 from colonsim.insertion.case.results import read_final_shape  # noqa: E402
+from colonsim.insertion.study.sweep_rows import input_row  # noqa: E402
+
+
+# the runs' cases: real inputs whose keys the table's schema can check (colonsim.schemas)
+CASES = {f"k{i}": InsertionCase(diameter_mm=20.0 + i) for i in range(1, 10)}
+K = {name: case.key() for name, case in CASES.items()}
+INPUTS = {case.key(): input_row(case) for case in CASES.values()}
 
 
 def _run_folder(folder, key, seed, n=400):
@@ -37,7 +45,7 @@ def _run_folder(folder, key, seed, n=400):
     (run / "summary.json").write_text(json.dumps({"key": key, "points_cm": {"A": {"depth_cm": 1.0}}}), encoding="utf-8")
     shape = {"colon_m": rng.normal(0.0, 0.05, (300, 3)), "scope_m": rng.normal(0.0, 0.2, (60, 3))}
     np.savez_compressed(run / "final_shape.npz", **shape)
-    return {"key": key, "status": "ok", "timeseries_path": f"runs/{key}/timeseries.csv",
+    return {**INPUTS[key], "key": key, "status": "ok", "timeseries_path": f"runs/{key}/timeseries.csv",
             "final_deformation_cm": float(series["deformation_cm"].iloc[-1]), "git_commit": "abc",
             "finished_at": f"2026-12-01T00:00:{seed:02d}"}, series, shape
 
@@ -49,7 +57,7 @@ def _sweep(folder, keys, failed=(), seed=0, name="demo", defined=None):
         row, series, shape = _run_folder(folder, key, seed + i)
         rows.append(row)
         made[key] = (series, shape)
-    rows += [{"key": k, "status": "failed", "timeseries_path": "", "final_deformation_cm": np.nan,
+    rows += [{**INPUTS[k], "key": k, "status": "failed", "timeseries_path": "", "final_deformation_cm": np.nan,
               "git_commit": "abc", "finished_at": "2026-12-01T01:00:00"} for k in failed]
     pd.DataFrame(rows).to_parquet(folder / "results.parquet", index=False)
     all_keys = list(defined or (list(keys) + list(failed)))  # the cases the sweep defines, finished or not
@@ -58,7 +66,7 @@ def _sweep(folder, keys, failed=(), seed=0, name="demo", defined=None):
 
 
 def test_pack_then_unpack_gives_the_report_the_same_run(tmp_path):
-    made = _sweep(tmp_path / "sweep", ["k1", "k2"], failed=["k3"])
+    made = _sweep(tmp_path / "sweep", [K["k1"], K["k2"]], failed=[K["k3"]])
     done = records.pack(tmp_path / "sweep", tmp_path / "record")
     assert done == {"packed": 3, "incomplete": [], "rows": 3}
     records.unpack(tmp_path / "record", tmp_path / "again")
@@ -81,11 +89,11 @@ def test_pack_then_unpack_gives_the_report_the_same_run(tmp_path):
         shape_back = read_final_shape(run)
         for name, x in shape.items():
             np.testing.assert_allclose(shape_back[name], x, rtol=0, atol=0.5 * records.SHAPE_QUANTUM * 1.001)
-    assert not (tmp_path / "again" / "runs" / "k3").exists()
+    assert not (tmp_path / "again" / "runs" / K["k3"]).exists()
 
 
 def test_the_report_reads_an_unpacked_record_as_the_sweep(tmp_path):
-    _sweep(tmp_path / "sweep", ["k1", "k2"])
+    _sweep(tmp_path / "sweep", [K["k1"], K["k2"]])
     records.pack(tmp_path / "sweep", tmp_path / "record")
     records.unpack(tmp_path / "record", tmp_path / "again")
     table = pd.read_parquet(tmp_path / "sweep" / "results.parquet")
@@ -100,27 +108,27 @@ def test_the_report_reads_an_unpacked_record_as_the_sweep(tmp_path):
 
 
 def test_a_record_grows_over_sittings_and_keeps_what_a_later_folder_lacks(tmp_path):
-    _sweep(tmp_path / "first", ["k1"], seed=1, defined=["k1", "k2"])
+    _sweep(tmp_path / "first", [K["k1"]], seed=1, defined=[K["k1"], K["k2"]])
     records.pack(tmp_path / "first", tmp_path / "record")
     # the next sitting: the record unpacked, one more run added by the resumed sweep
     records.unpack(tmp_path / "record", tmp_path / "second")
-    row, _, _ = _run_folder(tmp_path / "second", "k2", 7)
+    row, _, _ = _run_folder(tmp_path / "second", K["k2"], 7)
     table = pd.concat([pd.read_parquet(tmp_path / "second" / "results.parquet"), pd.DataFrame([row])])
     table.to_parquet(tmp_path / "second" / "results.parquet", index=False)
-    first = {p.name: p.read_bytes() for p in (tmp_path / "record" / "runs" / "k1").iterdir()}
+    first = {p.name: p.read_bytes() for p in (tmp_path / "record" / "runs" / K["k1"]).iterdir()}
     done = records.pack(tmp_path / "second", tmp_path / "record")
     assert done["rows"] == 2 and done["packed"] == 1  # k1, held already, is not packed again
-    assert {p.name: p.read_bytes() for p in (tmp_path / "record" / "runs" / "k1").iterdir()} == first
+    assert {p.name: p.read_bytes() for p in (tmp_path / "record" / "runs" / K["k1"]).iterdir()} == first
     # a folder holding only one of them, a later run of k2, replaces k2 and keeps k1
-    made = _sweep(tmp_path / "third", ["k2"], seed=8, defined=["k1", "k2"])
+    made = _sweep(tmp_path / "third", [K["k2"]], seed=8, defined=[K["k1"], K["k2"]])
     assert records.pack(tmp_path / "third", tmp_path / "record") == {"packed": 1, "incomplete": [], "rows": 2}
-    np.testing.assert_allclose(records.unpack_series(pd.read_parquet(tmp_path / "record" / "runs" / "k2" / "series.parquet"))
-                               ["depth_cm"], made["k2"][0]["depth_cm"], rtol=0, atol=1e-5)
-    assert sorted(pd.read_parquet(tmp_path / "record" / "results.parquet")["key"]) == ["k1", "k2"]
+    np.testing.assert_allclose(records.unpack_series(pd.read_parquet(tmp_path / "record" / "runs" / K["k2"] / "series.parquet"))
+                               ["depth_cm"], made[K["k2"]][0]["depth_cm"], rtol=0, atol=1e-5)
+    assert sorted(pd.read_parquet(tmp_path / "record" / "results.parquet")["key"]) == [K["k1"], K["k2"]]
 
 
 def test_status_says_what_a_record_holds(tmp_path, capsys):
-    _sweep(tmp_path / "sweep", ["k1", "k2"], failed=["k3"], defined=["k1", "k2", "k3", "k4"], name="thesis")
+    _sweep(tmp_path / "sweep", [K["k1"], K["k2"]], failed=[K["k3"]], defined=[K["k1"], K["k2"], K["k3"], K["k4"]], name="thesis")
     records.pack(tmp_path / "sweep", tmp_path / "records" / "thesis")
     assert records.status(tmp_path / "records" / "thesis") == {
         "record": "thesis", "sweep": "thesis", "defined": 4, "ok": 2, "failed": 1, "code": {"abc": 3}}
@@ -129,17 +137,17 @@ def test_status_says_what_a_record_holds(tmp_path, capsys):
 
 
 def test_a_run_folder_that_is_not_complete_is_left_out_and_named(tmp_path):
-    _sweep(tmp_path / "sweep", ["k1", "k2"])
-    (tmp_path / "sweep" / "runs" / "k2" / "final_shape.npz").unlink()
+    _sweep(tmp_path / "sweep", [K["k1"], K["k2"]])
+    (tmp_path / "sweep" / "runs" / K["k2"] / "final_shape.npz").unlink()
     done = records.pack(tmp_path / "sweep", tmp_path / "record")
-    assert done["incomplete"] == ["k2"] and done["rows"] == 1
+    assert done["incomplete"] == [K["k2"]] and done["rows"] == 1
 
 
 def test_bad_folders_are_one_line(tmp_path, capsys):
     assert records.main(["pack", str(tmp_path / "nothing"), str(tmp_path / "record")]) == 2
     assert "no results.parquet" in capsys.readouterr().err
-    _sweep(tmp_path / "a", ["k1"], name="a")
-    _sweep(tmp_path / "b", ["k9"], name="b")
+    _sweep(tmp_path / "a", [K["k1"]], name="a")
+    _sweep(tmp_path / "b", [K["k9"]], name="b")
     records.pack(tmp_path / "a", tmp_path / "record")
     with pytest.raises(ColonsimError, match="holds another sweep"):
         records.pack(tmp_path / "b", tmp_path / "record")
@@ -165,6 +173,7 @@ def test_colonsim_sweep_resumes_in_an_unpacked_record(tmp_path, capsys):
     toml = ROOT / "benchmarks" / "sweeps" / "smoothness.toml"
     spec = load_sweep(toml)
     keys = [c.key() for c in spec.cases]
+    INPUTS.update({c.key(): input_row(c) for c in spec.cases[:3]})
     _sweep(tmp_path / "sweep", keys[:3])
     (tmp_path / "sweep" / "sweep.json").write_text(json.dumps(spec.document()), encoding="utf-8")
     records.pack(tmp_path / "sweep", tmp_path / "record")

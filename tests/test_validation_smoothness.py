@@ -37,8 +37,12 @@ def test_the_larger_of_two_cubics_follows_the_crease_a_cubic_cannot(tmp_path):
 
     a = 0.25 * DIAMETERS - 1.2  # rises through c
     c = 1.45 + 0.02 * (DIAMETERS - 9.0)
-    table = pd.DataFrame({"scope": [f"{d:g}" for d in DIAMETERS], "status": "ok", "point_A_cm": a, "point_C_cm": c,
-                          "max_deformation_cm": np.maximum(a, c), "final_deformation_cm": c})
+    from colonsim.insertion.case.insertion_case import InsertionCase
+    from colonsim.insertion.study.sweep_rows import input_row
+
+    cases = [InsertionCase(scope=f"{d:g}") for d in DIAMETERS]  # a results table's rows: its schema is checked
+    table = pd.DataFrame([{**input_row(case), "key": case.key()} for case in cases]).assign(
+        status="ok", point_A_cm=a, point_C_cm=c, max_deformation_cm=np.maximum(a, c), final_deformation_cm=c)
     table.to_parquet(tmp_path / "results.parquet")
     d, residuals, ranges, crease = bench_smoothness.departures(tmp_path)
     assert np.allclose(d, DIAMETERS)
