@@ -10,7 +10,12 @@ per-step time, element updates per second per core
 projected wall time of a 0.5 s simulated push at the solver's time step.
 
 Run: ``python benchmarks/bench_solver.py [--steps 2000] [--threads 2] [--mesh 3e-3] [--rod-spacing 5e-3] [--repeat 1]
-[--devices] [--baseline CHECKOUT | --baseline-python PYTHON]``
+[--devices] [--engines] [--baseline CHECKOUT | --baseline-python PYTHON]``
+
+``--engines`` builds the model twice in this process, once with the wall's element-by-element
+force kernel (the engine before the blocked kernel, ``Shell.force_kernel = "elementwise"``) and
+once with today's, alternates their timed runs and prints both per-step times, their ratio and
+whether the final positions are identical (they are: the two kernels do the same arithmetic).
 
 ``--devices`` gives the scope the insertion's quasi-static devices (docs/model.md, "Time
 integration and damping": implicit axial and lateral damping instead of mass damping, the
@@ -112,10 +117,12 @@ def build(e, mesh_size=3e-3, rod_spacing=5e-3, friction=0.1, devices=False):
 class TimedModel:
     """The reference model of one engine, warmed up, timed in runs of a number of steps."""
 
-    def __init__(self, e, args):
+    def __init__(self, e, args, force_kernel=None):
         t0 = time.perf_counter()
         self.sim, self.colon, self.scope, self.contact = build(e, mesh_size=args.mesh, rod_spacing=args.rod_spacing,
                                                                devices=args.devices)
+        if force_kernel is not None:
+            self.colon.force_kernel = force_kernel
         for _ in range(20):  # compile and build the candidate list
             self.sim.advance()
         self.warm = time.perf_counter() - t0
@@ -191,6 +198,9 @@ def main():
     parser.add_argument("--rod-spacing", type=float, default=5e-3, help="scope node spacing, m")
     parser.add_argument("--repeat", type=int, default=1, help="timed runs of --steps steps; the median is reported")
     parser.add_argument("--devices", action="store_true", help="the scope with the insertion's quasi-static devices")
+    parser.add_argument("--engines", action="store_true",
+                        help="also the wall's element-by-element force kernel (the engine before the blocked one), "
+                             "timed run for run alternately in this process")
     parser.add_argument("--baseline-python", type=Path, default=None,
                         help="the Python of an environment with another (package-layout) checkout installed: it "
                              "runs the same model in a child process, timed run for run alternately")
@@ -206,11 +216,14 @@ def main():
     if args.serve:
         return serve(model, args)
     base = TimedModel(baseline_engine(args.baseline), args) if args.baseline else None
+    before = TimedModel(engine(CURRENT), args, force_kernel="elementwise") if args.engines else None
     child = ChildModel(args) if args.baseline_python else None
     for _ in range(max(args.repeat, 1)):
         model.run(args.steps)
         if base is not None:
             base.run(args.steps)
+        if before is not None:
+            before.run(args.steps)
         if child is not None:
             child.run(args.steps)
     sim, colon, scope, contact = model.sim, model.colon, model.scope, model.contact
@@ -248,6 +261,16 @@ def main():
         print(f"baseline {args.baseline}: per step {base_wall / args.steps * 1e3:.3f} ms (runs "
               + ", ".join(f"{w / args.steps * 1e3:.3f}" for w, _, _ in base.runs) + " ms); this checkout / baseline = "
               f"{wall / base_wall:.3f}; final positions {'identical' if same else 'DIFFER'}")
+
+    if before is not None:
+        same = all(np.array_equal(sim.state[n].x, before.sim.state[n].x) for n in ("colon", "scope"))
+        before_wall, _, before_shell = before.median()
+        print(f"before the blocked wall kernel (elementwise): per step {before_wall / args.steps * 1e3:.3f} ms, wall "
+              f"internal forces {before_shell / args.steps * 1e3:.3f} ms (runs "
+              + ", ".join(f"{w / args.steps * 1e3:.3f}" for w, _, _ in before.runs) + " ms); today's: per step "
+              f"{per_step * 1e3:.3f} ms, wall internal forces {shell_wall / args.steps * 1e3:.3f} ms; today / before = "
+              f"{wall / before_wall:.3f} per step, {shell_wall / before_shell:.3f} wall forces; final positions "
+              f"{'identical' if same else 'DIFFER'}")
 
 
 if __name__ == "__main__":

@@ -6,7 +6,10 @@ follower pressure, with lumped masses and a stable time step; docs/model.md for 
 
 All kernels are ``numba`` functions over raw arrays; the per-element buffers are summed onto nodes
 without races by :func:`colonsim.insertion.engine._scatter.gather`, or, for the internal forces,
-by one fused kernel that gives each thread its own nodal array.
+by one fused kernel that gives each thread its own nodal array: by default the blocked kernel of
+:mod:`colonsim.insertion.engine.shell_blocked`, which gives the forces of the element-by-element
+:func:`internal_forces_kernel` here to the last bit in about two thirds of its time
+(:attr:`Shell.force_kernel`; benchmarks/bench_solver.py times the two).
 
 Numba's cache checks only a kernel's own file (measured): the fused kernel here compiles in code
 from shell_membrane.py, shell_hinges.py and colonsim/laws.py, so after editing those delete
@@ -22,6 +25,7 @@ import numpy as np
 from colonsim.errors import ColonsimError
 from colonsim.insertion.engine._scatter import gather, node_incidence
 from colonsim.insertion.engine.sheet_mesh import hinges as mesh_hinges
+from colonsim.insertion.engine.shell_blocked import blocked_forces_kernel, triangle_reference
 from colonsim.insertion.engine.shell_hinges import (bending_stiffness, dihedral_angles, fast_atan, hinge_rowsum_kernel,
                                                     hinge_stiffness, hinge_terms, max_row_over_mass)
 from colonsim.insertion.engine.shell_membrane import (check_dispatched, membrane_omega2_kernel, membrane_triangle,
@@ -225,6 +229,12 @@ class Shell:
     The instance owns work buffers, so one instance must not be evaluated from two threads.
     """
 
+    #: The kernel of the internal forces: "blocked" (:func:`~colonsim.insertion.engine.shell_blocked.
+    #: blocked_forces_kernel`) or "elementwise" (:func:`internal_forces_kernel`, the earlier one, the
+    #: same forces to the last bit; kept as the reference that tests/test_shell_blocked.py and the
+    #: benchmarks compare against). Set on the class or on an instance.
+    force_kernel = "blocked"
+
     def __init__(self, nodes, triangles, thickness, material, density=1040.0, name="colon"):
         nodes = np.ascontiguousarray(nodes, dtype=np.float64)
         triangles = np.ascontiguousarray(triangles, dtype=np.int64)
@@ -299,6 +309,7 @@ class Shell:
             self._active = tuple(np.ascontiguousarray(a[on]) for a, on in (
                 (self.triangles, tri_on), (self.dm_inv, tri_on), (self.area0, tri_on), (self.hinges, hinge_on),
                 (self.hinge_stiffness, hinge_on), (self.theta0, hinge_on)))
+        self._active_reference = triangle_reference(self._active[1], self._active[2], self.thickness)
 
     @property
     def n_nodes(self):
@@ -314,7 +325,7 @@ class Shell:
     def internal_forces(self, x, f):
         """Add internal elastic forces (-dE/dx) for positions x into f (n, 3); return strain energy, J.
 
-        Membrane and hinge forces in one fused kernel (:func:`internal_forces_kernel`).
+        Membrane and hinge forces in one fused kernel (:attr:`force_kernel`).
         """
         self._check_x(x)
         n_chunks = numba.get_num_threads()
@@ -326,10 +337,16 @@ class Shell:
         direct = n_chunks == 1 and f.dtype == np.float64 and f.flags.c_contiguous and f.shape == x.shape
         out = f.reshape((1,) + f.shape) if direct else self._chunk_f
         tri, dm_inv, area0, hinges, hinge_stiffness, theta0 = self._active  # the elements not all held
-        internal_forces_kernel(
-            x, tri, dm_inv, area0, self.thickness, self._law, self._law_params, hinges, hinge_stiffness, theta0, out,
-            not direct, self._chunk_energy, self._chunk_count,
-        )
+        if self.force_kernel == "blocked":
+            blocked_forces_kernel(x, tri, self._active_reference, self._law, self._law_params, hinges, hinge_stiffness,
+                                  theta0, out, not direct, self._chunk_energy, self._chunk_count)
+        elif self.force_kernel == "elementwise":
+            internal_forces_kernel(
+                x, tri, dm_inv, area0, self.thickness, self._law, self._law_params, hinges, hinge_stiffness, theta0,
+                out, not direct, self._chunk_energy, self._chunk_count,
+            )
+        else:
+            raise ColonsimError(f"Shell.force_kernel = {self.force_kernel!r}: use 'blocked' or 'elementwise'.")
         n_inv, n_bad = self._chunk_count.sum(axis=0) if self._chunk_count.any() else (0, 0)
         if n_inv:
             raise ColonsimError(
