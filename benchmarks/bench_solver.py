@@ -10,12 +10,14 @@ per-step time, element updates per second per core
 projected wall time of a 0.5 s simulated push at the solver's time step.
 
 Run: ``python benchmarks/bench_solver.py [--steps 2000] [--threads 2] [--mesh 3e-3] [--rod-spacing 5e-3] [--repeat 1]
-[--devices] [--engines] [--baseline CHECKOUT | --baseline-python PYTHON]``
+[--devices] [--engines] [--elements] [--baseline CHECKOUT | --baseline-python PYTHON]``
 
 ``--engines`` builds the model twice in this process, once with the wall's element-by-element
 force kernel (the engine before the blocked kernel, ``Shell.force_kernel = "elementwise"``) and
 once with today's, alternates their timed runs and prints both per-step times, their ratio and
 whether the final positions are identical (they are: the two kernels do the same arithmetic).
+``--elements`` prints the CPU time of one triangle and one hinge in each of the two kernels
+(membrane and hinge passes timed apart, alternately, at the final positions).
 
 ``--devices`` gives the scope the insertion's quasi-static devices (docs/model.md, "Time
 integration and damping": implicit axial and lateral damping instead of mass damping, the
@@ -189,6 +191,42 @@ class ChildModel:
         return sorted(self.runs)[len(self.runs) // 2], {"colon": x["colon"], "scope": x["scope"]}
 
 
+def element_costs(colon, x, repeat=15, calls=20):
+    """Median seconds per triangle and per hinge of the wall's membrane and hinge passes, for the
+    element-by-element kernel and the blocked one, timed alternately in this process (CPU time,
+    which a shared machine disturbs less than wall time) at the positions ``x``."""
+    from colonsim.insertion.engine.shell import internal_forces_kernel
+    from colonsim.insertion.engine.shell_blocked import blocked_forces_kernel, triangle_reference
+
+    tri, dm_inv, area0, hinges, stiffness, theta0 = colon.triangles, colon.dm_inv, colon.area0, colon.hinges, \
+        colon.hinge_stiffness, colon.theta0
+    ref = triangle_reference(dm_inv, area0, colon.thickness)
+    out = np.zeros((1,) + x.shape)
+    energy = np.zeros((1, 2))
+    count = np.zeros((1, 2), dtype=np.int64)
+    law, params, t = colon._law, colon._law_params, colon.thickness
+
+    def elementwise(nt, nh):
+        internal_forces_kernel(x, tri[:nt], dm_inv[:nt], area0[:nt], t, law, params, hinges[:nh], stiffness[:nh],
+                               theta0[:nh], out, False, energy, count)
+
+    def blocked(nt, nh):
+        blocked_forces_kernel(x, tri[:nt], ref[:, :nt], law, params, hinges[:nh], stiffness[:nh], theta0[:nh], out,
+                              False, energy, count)
+
+    passes = {"membrane": (len(tri), 0), "hinges": (0, len(hinges))}
+    times = {(k, p): [] for k in ("elementwise", "blocked") for p in passes}
+    for _ in range(repeat):
+        for kernel_name, kernel in (("elementwise", elementwise), ("blocked", blocked)):
+            for p, sizes in passes.items():
+                kernel(*sizes)
+                t0 = time.process_time()
+                for _ in range(calls):
+                    kernel(*sizes)
+                times[kernel_name, p].append((time.process_time() - t0) / calls / max(sizes))
+    return {key: float(np.median(v)) for key, v in times.items()}
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--steps", type=int, default=2000, help="timed steps")
@@ -198,6 +236,8 @@ def main():
     parser.add_argument("--rod-spacing", type=float, default=5e-3, help="scope node spacing, m")
     parser.add_argument("--repeat", type=int, default=1, help="timed runs of --steps steps; the median is reported")
     parser.add_argument("--devices", action="store_true", help="the scope with the insertion's quasi-static devices")
+    parser.add_argument("--elements", action="store_true",
+                        help="the cost of one triangle and one hinge in each wall kernel (one thread)")
     parser.add_argument("--engines", action="store_true",
                         help="also the wall's element-by-element force kernel (the engine before the blocked one), "
                              "timed run for run alternately in this process")
@@ -271,6 +311,13 @@ def main():
               f"{per_step * 1e3:.3f} ms, wall internal forces {shell_wall / args.steps * 1e3:.3f} ms; today / before = "
               f"{wall / before_wall:.3f} per step, {shell_wall / before_shell:.3f} wall forces; final positions "
               f"{'identical' if same else 'DIFFER'}")
+
+    if args.elements:
+        costs = element_costs(colon, sim.state["colon"].x)
+        print("per element, CPU time, median: " + "; ".join(
+            f"{kernel} {part} {costs[kernel, part] * 1e9:.1f} ns" for kernel, part in costs)
+            + f"; blocked / elementwise: membrane {costs['blocked', 'membrane'] / costs['elementwise', 'membrane']:.3f}, "
+            f"hinges {costs['blocked', 'hinges'] / costs['elementwise', 'hinges']:.3f}")
 
 
 if __name__ == "__main__":
