@@ -195,29 +195,24 @@ def element_costs(colon, x, repeat=15, calls=20):
     """Median seconds per triangle and per hinge of the wall's membrane and hinge passes, for the
     element-by-element kernel and the blocked one, timed alternately in this process (CPU time,
     which a shared machine disturbs less than wall time) at the positions ``x``."""
-    from colonsim.insertion.engine.shell import internal_forces_kernel
-    from colonsim.insertion.engine.shell_blocked import blocked_forces_kernel, triangle_reference
+    from colonsim.insertion.engine.shell_forces import internal_forces_kernel, triangle_reference
 
-    tri, dm_inv, area0, hinges, stiffness, theta0 = colon.triangles, colon.dm_inv, colon.area0, colon.hinges, \
-        colon.hinge_stiffness, colon.theta0
-    ref = triangle_reference(dm_inv, area0, colon.thickness)
+    tri, hinges, stiffness, theta0 = colon.triangles, colon.hinges, colon.hinge_stiffness, colon.theta0
+    ref = triangle_reference(colon.dm_inv, colon.area0, colon.thickness)
     out = np.zeros((1,) + x.shape)
     energy = np.zeros((1, 2))
     count = np.zeros((1, 2), dtype=np.int64)
-    law, params, t = colon._law, colon._law_params, colon.thickness
 
-    def elementwise(nt, nh):
-        internal_forces_kernel(x, tri[:nt], dm_inv[:nt], area0[:nt], t, law, params, hinges[:nh], stiffness[:nh],
-                               theta0[:nh], out, False, energy, count)
-
-    def blocked(nt, nh):
-        blocked_forces_kernel(x, tri[:nt], ref[:, :nt], law, params, hinges[:nh], stiffness[:nh], theta0[:nh], out,
-                              False, energy, count)
+    def structure(blocked):
+        def call(nt, nh):
+            internal_forces_kernel(x, tri[:nt], ref[:, :nt], colon._law, colon._law_params, hinges[:nh],
+                                   stiffness[:nh], theta0[:nh], out, False, energy, count, blocked)
+        return call
 
     passes = {"membrane": (len(tri), 0), "hinges": (0, len(hinges))}
     times = {(k, p): [] for k in ("elementwise", "blocked") for p in passes}
     for _ in range(repeat):
-        for kernel_name, kernel in (("elementwise", elementwise), ("blocked", blocked)):
+        for kernel_name, kernel in (("elementwise", structure(False)), ("blocked", structure(True))):
             for p, sizes in passes.items():
                 kernel(*sizes)
                 t0 = time.process_time()

@@ -8,7 +8,7 @@ from colonsim.errors import ColonsimError
 from colonsim.insertion.engine.material import REFERENCE_MATERIAL_PATH, WallMaterial, load_material
 from colonsim.insertion.engine.sheet_mesh import straight_tube
 from colonsim.insertion.engine.shell import Shell
-from colonsim.insertion.engine.shell_blocked import BLOCK
+from colonsim.insertion.engine.shell_forces import BLOCK
 
 # one material of each branch of the kernels (the reference file's law is Mooney-Rivlin's three-term)
 MATERIALS = {

@@ -1,19 +1,28 @@
-"""The wall's internal forces in blocks: gather, compute in vector registers, scatter.
+"""The wall's internal forces: membrane and hinges in one parallel pass, in either of two loop
+structures that do the same arithmetic.
 
-:func:`blocked_forces_kernel` gives the same membrane and hinge forces as the element-by-element
-kernel :func:`colonsim.insertion.engine.shell.internal_forces_kernel`, to the last bit: each
-element goes through the same arithmetic, and its forces are added onto the nodes in the same
-order. What differs is the loop structure. Element by element, one triangle's update is a long
-chain of scalar operations fenced by the loads of its nodes and the adds onto them, so the
-compiler cannot run two elements side by side. Here a block of elements goes through three
-loops: the gather reads the nodes' edge vectors into contiguous block arrays, the compute loop
-(straight-line arithmetic on those arrays and the per-element reference quantities, with no
-indirect access) runs several elements at once in the vector registers, and the scatter adds the
-results onto the nodes. The law is chosen once per block, so each law's compute loop is compiled
-apart with its branch folded away.
+:func:`internal_forces_kernel` splits the elements into one contiguous chunk per thread; chunk
+``c`` adds the forces of its triangles and hinges into its own nodal array ``out[c]``, so no two
+threads write the same memory (with one chunk ``out`` can be a view of the force array itself).
+Within a chunk the elements go
 
-The reference quantities of each element (Dm_inv, the volume t A0, the hinge stiffness and rest
-angle) are computed once (:func:`triangle_reference`), laid out one quantity per row.
+- element by element (``blocked`` false, the structure before 2026-12-07): one triangle's update
+  is a long chain of scalar operations fenced by the loads of its nodes and the adds onto them,
+  so the compiler cannot run two elements side by side (only the hinges' arctangents run in
+  blocks);
+- by blocks (``blocked`` true, the default): a block of elements goes through three loops. The
+  gather reads the nodes' edge vectors into contiguous block arrays, the compute loop
+  (straight-line arithmetic on those arrays and the per-element reference quantities, with no
+  indirect access) runs several elements at once in the vector registers, and the scatter adds
+  the results onto the nodes. The law is chosen once per block, so each law's compute loop is
+  compiled apart with its branch folded away.
+
+Each element goes through the same operations in both, and its forces are added onto the nodes in
+the same order, so the two give the same forces and energies to the last bit
+(tests/test_shell_blocked.py; benchmarks/bench_solver.py ``--engines`` times them). The reference
+quantities of each triangle (Dm_inv and the volume t A0) are computed once
+(:func:`triangle_reference`), one quantity per row; the hinges' stiffness and rest angle are
+arrays of their own.
 """
 
 import math
@@ -22,7 +31,7 @@ import numba
 import numpy as np
 
 from colonsim import laws
-from colonsim.insertion.engine.shell_hinges import fast_atan, hinge_terms_of_edges
+from colonsim.insertion.engine.shell_hinges import fast_atan, hinge_terms, hinge_terms_of_edges
 from colonsim.insertion.engine.shell_membrane import membrane_terms
 
 BLOCK = 64  # elements per block: its arrays (~11 kB for hinges) stay in L1 (32 and 128 measured slower or equal)
@@ -165,14 +174,94 @@ def _hinge_chunk(x, hinge, stiffness, theta0, lo, hi, f):
     return e_bend, n_bad
 
 
-@numba.njit(parallel=True, cache=True)
-def blocked_forces_kernel(x, tri, ref, law, params, hinge, stiffness, theta0, out, zero, energy, count):
-    """Membrane and hinge forces of the wall, by blocks, onto per-thread nodal arrays.
+@numba.njit(cache=True, inline="always")
+def _elementwise_chunk(x, tri, ref, law, p, hinge, stiffness, theta0, t_lo, t_hi, h_lo, h_hi, f):
+    """Forces of triangles t_lo..t_hi and hinges h_lo..h_hi added onto f element by element;
+    returns (membrane energy J, inverted count, bending energy J, collapsed count)."""
+    e_mem = 0.0
+    n_inv = 0
+    for e in range(t_lo, t_hi):
+        i0 = tri[e, 0]
+        i1 = tri[e, 1]
+        i2 = tri[e, 2]
+        w, ok, h1, h2 = membrane_terms(x[i1, 0] - x[i0, 0], x[i1, 1] - x[i0, 1], x[i1, 2] - x[i0, 2],
+                                       x[i2, 0] - x[i0, 0], x[i2, 1] - x[i0, 1], x[i2, 2] - x[i0, 2], ref[0, e],
+                                       ref[1, e], ref[2, e], ref[3, e], ref[4, e], law, p)
+        if not ok:
+            n_inv += 1
+        e_mem += w
+        for k in range(3):
+            f[i1, k] += h1[k]
+            f[i2, k] += h2[k]
+            f[i0, k] += -(h1[k] + h2[k])
+    # Hinges in blocks: the angle arguments and gradients of a block first, then all its
+    # arctangents in one tight loop (one long dependency chain each, which a loop of whole
+    # hinges cannot overlap), then the forces.
+    e_bend = 0.0
+    n_bad = 0
+    ys = np.empty(BLOCK)
+    xs = np.empty(BLOCK)
+    th = np.empty(BLOCK)
+    g = np.empty((BLOCK, 9))
+    for start in range(h_lo, h_hi, BLOCK):
+        nb = min(BLOCK, h_hi - start)
+        for j in range(nb):
+            h = start + j
+            sin_part, cos_part, ok, gc, gd, al1, al2 = hinge_terms(x, hinge[h, 0], hinge[h, 1], hinge[h, 2],
+                                                                   hinge[h, 3])
+            ys[j] = sin_part
+            xs[j] = cos_part
+            for k in range(3):
+                g[j, k] = gc[k]
+                g[j, 3 + k] = gd[k]
+            g[j, 6] = al1
+            g[j, 7] = al2
+            g[j, 8] = 1.0 if ok else 0.0
+        for j in range(nb):  # fast_atan2 without its branches
+            t = fast_atan(ys[j] / xs[j])
+            th[j] = t + math.copysign(math.pi, ys[j]) if xs[j] < 0.0 else t
+        for j in range(nb):
+            h = start + j
+            if g[j, 8] == 0.0:
+                n_bad += 1
+                continue
+            theta = th[j]
+            if not (xs[j] > 0.0 or xs[j] < 0.0):  # cos_part 0 or NaN: as _atan2 does
+                theta = math.atan2(ys[j], xs[j])
+            dth = theta - theta0[h]
+            e_bend += stiffness[h] * dth * dth
+            coef = -2.0 * stiffness[h] * dth
+            a = hinge[h, 0]
+            b = hinge[h, 1]
+            cc = hinge[h, 2]
+            d = hinge[h, 3]
+            al1 = g[j, 6]
+            al2 = g[j, 7]
+            for k in range(3):
+                gc = g[j, k]
+                gd = g[j, 3 + k]
+                f[cc, k] += gc * coef
+                f[d, k] += gd * coef
+                f[a, k] += (-(1.0 - al1) * gc - (1.0 - al2) * gd) * coef
+                f[b, k] += (-al1 * gc - al2 * gd) * coef
+    return e_mem, n_inv, e_bend, n_bad
 
-    The same contract as :func:`colonsim.insertion.engine.shell.internal_forces_kernel` (chunk
-    ``c`` of the elements adds into ``out[c]``, set to zero first if ``zero``; energies and
-    counts per chunk), with the triangles' reference quantities ``ref`` of
-    :func:`triangle_reference` in place of Dm_inv, A0 and t.
+
+@numba.njit(parallel=True, cache=True)
+def internal_forces_kernel(x, tri, ref, law, params, hinge, stiffness, theta0, out, zero, energy, count, blocked):
+    """Membrane and hinge forces of the wall onto per-thread nodal arrays, by blocks or element by
+    element (``blocked``; module docstring).
+
+    Parameters
+    ----------
+    ref : (5, nt) float64
+        The triangles' reference quantities (:func:`triangle_reference`).
+    out : (n_chunks, n, 3) float64
+        Per-chunk nodal forces, added to (set to zero first if ``zero``).
+    energy : (n_chunks, 2) float64
+        Membrane and bending strain energy of each chunk, J (written).
+    count : (n_chunks, 2) int64
+        Inverted triangles and collapsed hinges of each chunk (written).
     """
     n_chunks = out.shape[0]
     nt = tri.shape[0]
@@ -181,8 +270,16 @@ def blocked_forces_kernel(x, tri, ref, law, params, hinge, stiffness, theta0, ou
         f = out[c]
         if zero:
             f[:, :] = 0.0
-        e_mem, n_inv = _membrane_chunk(x, tri, ref, law, params, c * nt // n_chunks, (c + 1) * nt // n_chunks, f)
-        e_bend, n_bad = _hinge_chunk(x, hinge, stiffness, theta0, c * nh // n_chunks, (c + 1) * nh // n_chunks, f)
+        t_lo = c * nt // n_chunks
+        t_hi = (c + 1) * nt // n_chunks
+        h_lo = c * nh // n_chunks
+        h_hi = (c + 1) * nh // n_chunks
+        if blocked:
+            e_mem, n_inv = _membrane_chunk(x, tri, ref, law, params, t_lo, t_hi, f)
+            e_bend, n_bad = _hinge_chunk(x, hinge, stiffness, theta0, h_lo, h_hi, f)
+        else:
+            e_mem, n_inv, e_bend, n_bad = _elementwise_chunk(x, tri, ref, law, params, hinge, stiffness, theta0,
+                                                             t_lo, t_hi, h_lo, h_hi, f)
         energy[c, 0] = e_mem
         energy[c, 1] = e_bend
         count[c, 0] = n_inv
