@@ -127,9 +127,10 @@ class Shell:
     """
 
     #: The loop structure of the internal forces (:mod:`colonsim.insertion.engine.shell_forces`):
-    #: "blocked" or "elementwise" (the one before 2026-12-07, the same forces to the last bit in
-    #: 1.3-1.6 times the time; kept as the reference that tests/test_shell_blocked.py and the
-    #: benchmarks compare against). Set on the class or on an instance.
+    #: "blocked" or "elementwise" (each element in turn, as the engine did first: the same forces
+    #: to the last bit in 1.3-1.6 times the time; kept as the reference that
+    #: tests/test_shell_blocked.py and the benchmarks compare against). Set on the class or on an
+    #: instance.
     force_kernel = "blocked"
 
     def __init__(self, nodes, triangles, thickness, material, density=1040.0, name="colon"):

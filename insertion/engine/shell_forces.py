@@ -6,7 +6,7 @@ structures that do the same arithmetic.
 threads write the same memory (with one chunk ``out`` can be a view of the force array itself).
 Within a chunk the elements go
 
-- element by element (``blocked`` false, the structure before 2026-12-07): one triangle's update
+- element by element (``blocked`` false, the engine's first structure): one triangle's update
   is a long chain of scalar operations fenced by the loads of its nodes and the adds onto them,
   so the compiler cannot run two elements side by side (only the hinges' arctangents run in
   blocks);
@@ -14,7 +14,8 @@ Within a chunk the elements go
   gather reads the nodes' edge vectors into contiguous block arrays, the compute loop
   (straight-line arithmetic on those arrays and the per-element reference quantities, with no
   indirect access) runs several elements at once in the vector registers, and the scatter adds
-  the results onto the nodes. The law is chosen once per block, so each law's compute loop is
+  the results onto the nodes (a hinge's forces, a few products of its angle and gradients, are
+  formed there: 6 % faster than in a vector loop of their own). The law is chosen once per block, so each law's compute loop is
   compiled apart with its branch folded away.
 
 Each element goes through the same operations in both, and its forces are added onto the nodes in
@@ -150,7 +151,7 @@ def _hinge_chunk(x, hinge, stiffness, theta0, lo, hi, f):
         for j in range(nb):  # cos_part 0 or NaN: as math.atan2 does (rare)
             if not (xs[j] > 0.0 or xs[j] < 0.0):
                 th[j] = math.atan2(ys[j], xs[j])
-        for j in range(nb):  # the forces, scattered (computed here rather than in a vector loop: 6 % faster)
+        for j in range(nb):  # the forces, formed and scattered
             if ok[j] == 0.0:
                 n_bad += 1
                 continue
