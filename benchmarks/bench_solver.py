@@ -10,7 +10,14 @@ per-step time, element updates per second per core
 projected wall time of a 0.5 s simulated push at the solver's time step.
 
 Run: ``python benchmarks/bench_solver.py [--steps 2000] [--threads 2] [--mesh 3e-3] [--rod-spacing 5e-3] [--repeat 1]
-[--devices] [--baseline CHECKOUT | --baseline-python PYTHON]``
+[--devices] [--engines] [--elements] [--baseline CHECKOUT | --baseline-python PYTHON]``
+
+``--engines`` builds the model twice in this process, once with the wall's element-by-element
+force kernel (the engine before the blocked kernel, ``Shell.force_kernel = "elementwise"``) and
+once with today's, alternates their timed runs and prints both per-step times, their ratio and
+whether the final positions are identical (they are: the two kernels do the same arithmetic).
+``--elements`` prints the CPU time of one triangle and one hinge in each of the two kernels
+(membrane and hinge passes timed apart, alternately, at the final positions).
 
 ``--devices`` gives the scope the insertion's quasi-static devices (docs/model.md, "Time
 integration and damping": implicit axial and lateral damping instead of mass damping, the
@@ -112,10 +119,12 @@ def build(e, mesh_size=3e-3, rod_spacing=5e-3, friction=0.1, devices=False):
 class TimedModel:
     """The reference model of one engine, warmed up, timed in runs of a number of steps."""
 
-    def __init__(self, e, args):
+    def __init__(self, e, args, force_kernel=None):
         t0 = time.perf_counter()
         self.sim, self.colon, self.scope, self.contact = build(e, mesh_size=args.mesh, rod_spacing=args.rod_spacing,
                                                                devices=args.devices)
+        if force_kernel is not None:
+            self.colon.force_kernel = force_kernel
         for _ in range(20):  # compile and build the candidate list
             self.sim.advance()
         self.warm = time.perf_counter() - t0
@@ -182,6 +191,37 @@ class ChildModel:
         return sorted(self.runs)[len(self.runs) // 2], {"colon": x["colon"], "scope": x["scope"]}
 
 
+def element_costs(colon, x, repeat=15, calls=20):
+    """Median seconds per triangle and per hinge of the wall's membrane and hinge passes, for the
+    element-by-element kernel and the blocked one, timed alternately in this process (CPU time,
+    which a shared machine disturbs less than wall time) at the positions ``x``."""
+    from colonsim.insertion.engine.shell_forces import internal_forces_kernel, triangle_reference
+
+    tri, hinges, stiffness, theta0 = colon.triangles, colon.hinges, colon.hinge_stiffness, colon.theta0
+    ref = triangle_reference(colon.dm_inv, colon.area0, colon.thickness)
+    out = np.zeros((1,) + x.shape)
+    energy = np.zeros((1, 2))
+    count = np.zeros((1, 2), dtype=np.int64)
+
+    def structure(blocked):
+        def call(nt, nh):
+            internal_forces_kernel(x, tri[:nt], ref[:, :nt], colon._law, colon._law_params, hinges[:nh],
+                                   stiffness[:nh], theta0[:nh], out, False, energy, count, blocked)
+        return call
+
+    passes = {"membrane": (len(tri), 0), "hinges": (0, len(hinges))}
+    times = {(k, p): [] for k in ("elementwise", "blocked") for p in passes}
+    for _ in range(repeat):
+        for kernel_name, kernel in (("elementwise", structure(False)), ("blocked", structure(True))):
+            for p, sizes in passes.items():
+                kernel(*sizes)
+                t0 = time.process_time()
+                for _ in range(calls):
+                    kernel(*sizes)
+                times[kernel_name, p].append((time.process_time() - t0) / calls / max(sizes))
+    return {key: float(np.median(v)) for key, v in times.items()}
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--steps", type=int, default=2000, help="timed steps")
@@ -191,6 +231,11 @@ def main():
     parser.add_argument("--rod-spacing", type=float, default=5e-3, help="scope node spacing, m")
     parser.add_argument("--repeat", type=int, default=1, help="timed runs of --steps steps; the median is reported")
     parser.add_argument("--devices", action="store_true", help="the scope with the insertion's quasi-static devices")
+    parser.add_argument("--elements", action="store_true",
+                        help="the cost of one triangle and one hinge in each wall kernel (one thread)")
+    parser.add_argument("--engines", action="store_true",
+                        help="also the wall's element-by-element force kernel (the engine before the blocked one), "
+                             "timed run for run alternately in this process")
     parser.add_argument("--baseline-python", type=Path, default=None,
                         help="the Python of an environment with another (package-layout) checkout installed: it "
                              "runs the same model in a child process, timed run for run alternately")
@@ -206,11 +251,14 @@ def main():
     if args.serve:
         return serve(model, args)
     base = TimedModel(baseline_engine(args.baseline), args) if args.baseline else None
+    before = TimedModel(engine(CURRENT), args, force_kernel="elementwise") if args.engines else None
     child = ChildModel(args) if args.baseline_python else None
     for _ in range(max(args.repeat, 1)):
         model.run(args.steps)
         if base is not None:
             base.run(args.steps)
+        if before is not None:
+            before.run(args.steps)
         if child is not None:
             child.run(args.steps)
     sim, colon, scope, contact = model.sim, model.colon, model.scope, model.contact
@@ -248,6 +296,23 @@ def main():
         print(f"baseline {args.baseline}: per step {base_wall / args.steps * 1e3:.3f} ms (runs "
               + ", ".join(f"{w / args.steps * 1e3:.3f}" for w, _, _ in base.runs) + " ms); this checkout / baseline = "
               f"{wall / base_wall:.3f}; final positions {'identical' if same else 'DIFFER'}")
+
+    if before is not None:
+        same = all(np.array_equal(sim.state[n].x, before.sim.state[n].x) for n in ("colon", "scope"))
+        before_wall, _, before_shell = before.median()
+        print(f"before the blocked wall kernel (elementwise): per step {before_wall / args.steps * 1e3:.3f} ms, wall "
+              f"internal forces {before_shell / args.steps * 1e3:.3f} ms (runs "
+              + ", ".join(f"{w / args.steps * 1e3:.3f}" for w, _, _ in before.runs) + " ms); today's: per step "
+              f"{per_step * 1e3:.3f} ms, wall internal forces {shell_wall / args.steps * 1e3:.3f} ms; today / before = "
+              f"{wall / before_wall:.3f} per step, {shell_wall / before_shell:.3f} wall forces; final positions "
+              f"{'identical' if same else 'DIFFER'}")
+
+    if args.elements:
+        costs = element_costs(colon, sim.state["colon"].x)
+        print("per element, CPU time, median: " + "; ".join(
+            f"{kernel} {part} {costs[kernel, part] * 1e9:.1f} ns" for kernel, part in costs)
+            + f"; blocked / elementwise: membrane {costs['blocked', 'membrane'] / costs['elementwise', 'membrane']:.3f}, "
+            f"hinges {costs['blocked', 'hinges'] / costs['elementwise', 'hinges']:.3f}")
 
 
 if __name__ == "__main__":

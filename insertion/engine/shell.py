@@ -6,10 +6,12 @@ follower pressure, with lumped masses and a stable time step; docs/model.md for 
 
 All kernels are ``numba`` functions over raw arrays; the per-element buffers are summed onto nodes
 without races by :func:`colonsim.insertion.engine._scatter.gather`, or, for the internal forces,
-by one fused kernel that gives each thread its own nodal array.
+by one fused kernel that gives each thread its own nodal array
+(:mod:`colonsim.insertion.engine.shell_forces`, by blocks or element by element:
+:attr:`Shell.force_kernel`).
 
-Numba's cache checks only a kernel's own file (measured): the fused kernel here compiles in code
-from shell_membrane.py, shell_hinges.py and colonsim/laws.py, so after editing those delete
+Numba's cache checks only a kernel's own file (measured): the force kernel compiles in code from
+shell_membrane.py, shell_hinges.py and colonsim/laws.py, so after editing those delete
 ``insertion/engine/__pycache__`` or the old compiled code keeps running (a fresh checkout, as in
 CI, has no cache).
 """
@@ -22,115 +24,14 @@ import numpy as np
 from colonsim.errors import ColonsimError
 from colonsim.insertion.engine._scatter import gather, node_incidence
 from colonsim.insertion.engine.sheet_mesh import hinges as mesh_hinges
-from colonsim.insertion.engine.shell_hinges import (bending_stiffness, dihedral_angles, fast_atan, hinge_rowsum_kernel,
-                                                    hinge_stiffness, hinge_terms, max_row_over_mass)
-from colonsim.insertion.engine.shell_membrane import (check_dispatched, membrane_omega2_kernel, membrane_triangle,
-                                                      reference_frames)
+from colonsim.insertion.engine.shell_forces import internal_forces_kernel, triangle_reference
+from colonsim.insertion.engine.shell_hinges import (bending_stiffness, dihedral_angles, hinge_rowsum_kernel,
+                                                    hinge_stiffness, max_row_over_mass)
+from colonsim.insertion.engine.shell_membrane import check_dispatched, membrane_omega2_kernel, reference_frames
 
 # ---------------------------------------------------------------------------------------------
-# Internal forces: membrane and hinges fused
+# Internal forces: the per-thread arrays summed
 # ---------------------------------------------------------------------------------------------
-
-_HINGE_BLOCK = 64  # hinges per block of the fused kernel (scratch stays in L1)
-
-
-@numba.njit(parallel=True, cache=True)
-def internal_forces_kernel(x, tri, dm_inv, area0, thickness, law, params, hinge, stiffness, theta0, out, zero,
-                           energy, count):
-    """Membrane and hinge forces in one parallel region, scattered straight onto nodes.
-
-    The elements are split into ``out.shape[0]`` contiguous chunks, one per thread; chunk ``c``
-    adds the forces of its triangles and hinges into its own nodal array ``out[c]`` (n, 3), so no
-    two threads write the same memory. With one chunk ``out`` can be a view of the force array
-    itself and no gather is needed; with several, :func:`sum_chunks` adds them up. This replaces
-    two element kernels and two gathers (four fork/joins and a 4 MB buffer round trip per step).
-
-    Parameters
-    ----------
-    out : (n_chunks, n, 3) float64
-        Per-chunk nodal forces, added to (set to zero first if ``zero``).
-    energy : (n_chunks, 2) float64
-        Membrane and bending strain energy of each chunk, J (written).
-    count : (n_chunks, 2) int64
-        Inverted triangles and collapsed hinges of each chunk (written).
-    """
-    n_chunks = out.shape[0]
-    nt = tri.shape[0]
-    nh = hinge.shape[0]
-    for c in numba.prange(n_chunks):
-        f = out[c]
-        if zero:
-            f[:, :] = 0.0
-        e_mem = 0.0
-        n_inv = 0
-        for e in range(c * nt // n_chunks, (c + 1) * nt // n_chunks):
-            w, ok, h1, h2 = membrane_triangle(x, tri, dm_inv, thickness * area0[e], law, params, e)
-            if not ok:
-                n_inv += 1
-            e_mem += w
-            i0 = tri[e, 0]
-            i1 = tri[e, 1]
-            i2 = tri[e, 2]
-            for k in range(3):
-                f[i1, k] += h1[k]
-                f[i2, k] += h2[k]
-                f[i0, k] += -(h1[k] + h2[k])
-        # Hinges in blocks: the angle arguments and gradients of a block first, then all its
-        # arctangents in one tight loop (one long dependency chain each, which a loop of whole
-        # hinges cannot overlap), then the forces.
-        e_bend = 0.0
-        n_bad = 0
-        ys = np.empty(_HINGE_BLOCK)
-        xs = np.empty(_HINGE_BLOCK)
-        th = np.empty(_HINGE_BLOCK)
-        g = np.empty((_HINGE_BLOCK, 9))
-        h_end = (c + 1) * nh // n_chunks
-        for start in range(c * nh // n_chunks, h_end, _HINGE_BLOCK):
-            nb = min(_HINGE_BLOCK, h_end - start)
-            for j in range(nb):
-                h = start + j
-                sin_part, cos_part, ok, gc, gd, al1, al2 = hinge_terms(
-                    x, hinge[h, 0], hinge[h, 1], hinge[h, 2], hinge[h, 3]
-                )
-                ys[j] = sin_part
-                xs[j] = cos_part
-                for k in range(3):
-                    g[j, k] = gc[k]
-                    g[j, 3 + k] = gd[k]
-                g[j, 6] = al1
-                g[j, 7] = al2
-                g[j, 8] = 1.0 if ok else 0.0
-            for j in range(nb):  # fast_atan2 without its branches
-                t = fast_atan(ys[j] / xs[j])
-                th[j] = t + math.copysign(math.pi, ys[j]) if xs[j] < 0.0 else t
-            for j in range(nb):
-                h = start + j
-                if g[j, 8] == 0.0:
-                    n_bad += 1
-                    continue
-                theta = th[j]
-                if not (xs[j] > 0.0 or xs[j] < 0.0):  # cos_part 0 or NaN: as _atan2 does
-                    theta = math.atan2(ys[j], xs[j])
-                dth = theta - theta0[h]
-                e_bend += stiffness[h] * dth * dth
-                coef = -2.0 * stiffness[h] * dth
-                a = hinge[h, 0]
-                b = hinge[h, 1]
-                cc = hinge[h, 2]
-                d = hinge[h, 3]
-                al1 = g[j, 6]
-                al2 = g[j, 7]
-                for k in range(3):
-                    gc = g[j, k]
-                    gd = g[j, 3 + k]
-                    f[cc, k] += gc * coef
-                    f[d, k] += gd * coef
-                    f[a, k] += (-(1.0 - al1) * gc - (1.0 - al2) * gd) * coef
-                    f[b, k] += (-al1 * gc - al2 * gd) * coef
-        energy[c, 0] = e_mem
-        energy[c, 1] = e_bend
-        count[c, 0] = n_inv
-        count[c, 1] = n_bad
 
 
 @numba.njit(parallel=True, cache=True)
@@ -225,6 +126,13 @@ class Shell:
     The instance owns work buffers, so one instance must not be evaluated from two threads.
     """
 
+    #: The loop structure of the internal forces (:mod:`colonsim.insertion.engine.shell_forces`):
+    #: "blocked" or "elementwise" (each element in turn, as the engine did first: the same forces
+    #: to the last bit in 1.3-1.6 times the time; kept as the reference that
+    #: tests/test_shell_blocked.py and the benchmarks compare against). Set on the class or on an
+    #: instance.
+    force_kernel = "blocked"
+
     def __init__(self, nodes, triangles, thickness, material, density=1040.0, name="colon"):
         nodes = np.ascontiguousarray(nodes, dtype=np.float64)
         triangles = np.ascontiguousarray(triangles, dtype=np.int64)
@@ -299,6 +207,7 @@ class Shell:
             self._active = tuple(np.ascontiguousarray(a[on]) for a, on in (
                 (self.triangles, tri_on), (self.dm_inv, tri_on), (self.area0, tri_on), (self.hinges, hinge_on),
                 (self.hinge_stiffness, hinge_on), (self.theta0, hinge_on)))
+        self._active_reference = triangle_reference(self._active[1], self._active[2], self.thickness)
 
     @property
     def n_nodes(self):
@@ -314,7 +223,7 @@ class Shell:
     def internal_forces(self, x, f):
         """Add internal elastic forces (-dE/dx) for positions x into f (n, 3); return strain energy, J.
 
-        Membrane and hinge forces in one fused kernel (:func:`internal_forces_kernel`).
+        Membrane and hinge forces in one fused kernel (:attr:`force_kernel`).
         """
         self._check_x(x)
         n_chunks = numba.get_num_threads()
@@ -325,11 +234,12 @@ class Shell:
         # one chunk adds straight into f (a view), several into their own arrays summed below
         direct = n_chunks == 1 and f.dtype == np.float64 and f.flags.c_contiguous and f.shape == x.shape
         out = f.reshape((1,) + f.shape) if direct else self._chunk_f
-        tri, dm_inv, area0, hinges, hinge_stiffness, theta0 = self._active  # the elements not all held
-        internal_forces_kernel(
-            x, tri, dm_inv, area0, self.thickness, self._law, self._law_params, hinges, hinge_stiffness, theta0, out,
-            not direct, self._chunk_energy, self._chunk_count,
-        )
+        if self.force_kernel not in ("blocked", "elementwise"):
+            raise ColonsimError(f"Shell.force_kernel = {self.force_kernel!r}: use 'blocked' or 'elementwise'.")
+        tri, _, _, hinges, hinge_stiffness, theta0 = self._active  # the elements not all held
+        internal_forces_kernel(x, tri, self._active_reference, self._law, self._law_params, hinges, hinge_stiffness,
+                               theta0, out, not direct, self._chunk_energy, self._chunk_count,
+                               self.force_kernel == "blocked")
         n_inv, n_bad = self._chunk_count.sum(axis=0) if self._chunk_count.any() else (0, 0)
         if n_inv:
             raise ColonsimError(
