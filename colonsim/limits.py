@@ -51,7 +51,7 @@ GEOMETRY_RANGES_MM = {"length": (1e-2, 1e4), "width": (1e-3, 1e4), "thickness": 
 # the run uses it.
 OPTION_RANGES = {
     # a snapshot per time step would fill memory and disk; one per 10 s is none in a run of seconds
-    "--snapshot-every": (1e-3, 10.0, "simulated seconds between VTU snapshots"),
+    "--snapshot-every": (1e-3, 10.0, "simulated seconds between snapshots for --vtu and --animate"),
     # fewer points do not fix a law's curvature; more than a curve holds would invent points by
     # interpolation (checked per curve: colonsim.identification.cleanup.check_decimation)
     "--decimate": (5, 10_000, "points per curve, at most the curve's own"),

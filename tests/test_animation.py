@@ -95,7 +95,7 @@ def test_insert_writes_the_stretch_map_at_the_threshold_asked(animated):
 
 
 @pytest.mark.parametrize("args, message", [(["--stretch-threshold", "3"], "stretch threshold 3 is outside"),
-                                           (["--animate", "--snapshot-every", "0"], "--snapshot-every 0 s")])
+                                           (["--animate", "--snapshot-every", "0"], "--snapshot-every: 0 is outside 0.001-10")])
 def test_bad_visualisation_options_are_one_line(args, message, tmp_path, capsys):
     assert main(["insert", "--segment", "straight", *args, "--no-progress", "--out", str(tmp_path / "x")]) == 2
     err = capsys.readouterr().err.strip()
