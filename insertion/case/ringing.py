@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from colonsim.insertion.anatomy.manoeuvre import SETTLE
 from colonsim.insertion.case.outcomes import depth_trend, depth_weights
 
 RINGING_WINDOW = 0.01  # m of push: the moving average the push force rings about
@@ -131,6 +132,15 @@ def ringing_ratio(depth, push_force, in_contact, window=RINGING_WINDOW, floor_N=
     rms = float(np.sqrt(np.sum(w[counted] * (f[counted] - trend[counted]) ** 2) / total))
     return {"ratio": rms / max(mean, floor_N), "rms_N": rms, "mean_N": mean, "push_cm": total * 100,
             "snap_throughs": [s * 100 for s, _ in snaps], "left_out_share": 1.0 - total / pushed}
+
+
+def push_ringing(phase, depth, push_force, contact_nodes):
+    """:func:`ringing_ratio` of a run's recorded samples over its push: the closing settle phase
+    (``phase`` :data:`SETTLE`, the scope held still) left out. ``depth`` in m, ``push_force`` in N,
+    ``contact_nodes`` the scope-wall contacts per sample."""
+    pushing = np.asarray(phase) != SETTLE
+    return ringing_ratio(np.asarray(depth, dtype=float)[pushing], np.asarray(push_force, dtype=float)[pushing],
+                         np.asarray(contact_nodes)[pushing] > 0)
 
 
 def ringing_holds(ring) -> bool:

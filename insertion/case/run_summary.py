@@ -11,7 +11,7 @@ from colonsim.insertion.case.outcomes import (JAM_FORCE, JAM_PROGRESS, JAM_PUSH,
                                               quasi_static_fraction, rest_drift, turned_back)
 from colonsim.insertion.case.ringing import (RINGING_FORCE_FLOOR_N, RINGING_LIMIT, RINGING_WINDOW, SNAP_DROP_N,
                                              SNAP_DROP_PUSH, SNAP_DROP_SHARE, SNAP_LEFT_OUT_LIMIT, SNAP_LEFT_OUT_PUSH,
-                                             ringing_cause, ringing_holds, ringing_ratio)
+                                             push_ringing, ringing_cause, ringing_holds)
 from colonsim.insertion.case.stretch_map import wall_stretch_summary
 from colonsim.insertion.engine.material import REFERENCE_MATERIAL_PATH
 from colonsim.provenance import code_version
@@ -53,9 +53,7 @@ def quasi_static_summary(ts, energy_fractions, sliding) -> dict:
     """The run's quasi-static check (docs/quasi_static.md): the ringing ratio of the push force over
     the push (the closing settle phase left out: the scope is held there) with the snap-throughs it
     leaves out, and the kinetic/internal energy fractions as information."""
-    pushing = (ts["phase"] != SETTLE).to_numpy()
-    ring = ringing_ratio(ts["depth_m"].to_numpy()[pushing], ts["push_force_N"].to_numpy()[pushing],
-                         ts["contact_nodes"].to_numpy()[pushing] > 0)
+    ring = push_ringing(ts["phase"], ts["depth_m"], ts["push_force_N"], ts["contact_nodes"])
     return {
         "criterion": f"ringing ratio below {RINGING_LIMIT:g}: RMS of the push force about its moving average over "
                      f"{RINGING_WINDOW * 100:g} cm of push, over max(its mean, {RINGING_FORCE_FLOOR_N:g} N), from the "

@@ -29,7 +29,7 @@ import pandas as pd
 from colonsim.catalog import TIP_FOLDED
 from colonsim.insertion.anatomy.manoeuvre import SETTLE
 from colonsim.insertion.case.outcomes import characteristic_points, peak_trend
-from colonsim.insertion.case.ringing import ringing_cause, ringing_holds, ringing_ratio
+from colonsim.insertion.case.ringing import push_ringing, ringing_cause, ringing_holds
 
 RULES = "rules"
 CURRENT = "current"
@@ -49,9 +49,7 @@ def _series(folder, row):
 
 def requalified_ringing(ts) -> dict:
     """The ringing verdict of a run's time series (cm and N columns, as a run folder holds them)."""
-    pushing = (ts["phase"] != SETTLE).to_numpy()
-    ring = ringing_ratio(ts["depth_cm"].to_numpy()[pushing] / 100, ts["push_force_N"].to_numpy()[pushing],
-                         ts["contact_nodes"].to_numpy()[pushing] > 0)
+    ring = push_ringing(ts["phase"], ts["depth_cm"] / 100, ts["push_force_N"], ts["contact_nodes"])
     return {"ringing_ratio": ring["ratio"], "quasi_static": ringing_holds(ring),
             "snap_throughs": float(len(ring["snap_throughs"])), "ringing_left_out_share": ring["left_out_share"],
             "ringing_cause": ringing_cause(ring)}
