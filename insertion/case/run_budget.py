@@ -94,11 +94,7 @@ def estimate_run(case) -> RunBudget:
     stable = {b.name: b.critical_time_step(solver.state[b.name].x) for b in solver.bodies}
     # the bounds' step (bodies and contact): a budget errs on the long side, and the global estimate's
     # power iteration is not run on a model that may be absurd (a wall 1e10 times too stiff)
-    estimate, solver.global_estimate = solver.global_estimate, None
-    try:
-        dt = solver.time_step_factor * solver.stable_time_step()
-    finally:
-        solver.global_estimate = estimate
+    dt = solver.time_step_factor * solver.stable_time_step(bounds_only=True)
     if not (math.isfinite(dt) and dt > 0.0):
         raise ColonsimError(f"{case.segment} {case.scope}: no stable time step exists for this model ({dt!r} s); "
                             "check the wall material and mesh")

@@ -168,14 +168,15 @@ class ExplicitSolver:
                 b.mass[:] = b.mass * (target / dt_b) ** 2
                 self.added_mass[b.name] = float(b.mass.sum() - m0)
 
-    def stable_time_step(self):
+    def stable_time_step(self, bounds_only=False):
         """Stable time step estimate of the current state (before the safety factor), s.
 
         Per body omega^2 = (2 / dt_body)^2 plus the contact penalty's contribution on that body
         (Gershgorin: the stiffness rows add; a contact reports its damped springs as equivalent
         undamped ones). Contacts first adapt their penalty to the bodies' current frequencies (from
         the bounds, whichever estimate sets the step). With a ``global_estimate``, the step of the
-        coupled system's largest frequency instead, when it is the longer.
+        coupled system's largest frequency instead, when it is the longer; ``bounds_only`` keeps the
+        bounds' (a run's budget, sized before the run, does not run the power iteration).
         """
         omega2 = {b.name: (2.0 / b.critical_time_step(self.state[b.name].x)) ** 2 for b in self.bodies}
         floor = [omega2[b.name] for b in self.bodies if hasattr(b, "max_frequency")]  # a rod's is its eigenvalue
@@ -185,7 +186,7 @@ class ExplicitSolver:
                 omega2[name] += w2
                 floor.append(w2)
         bound = 2.0 / math.sqrt(max(omega2.values()))
-        if self.global_estimate is None:
+        if self.global_estimate is None or bounds_only:
             return bound
         # The power iteration sees the springs active at its last evaluation; a contact that appears
         # between two updates it cannot see. Each contact's own frequency as the bounds count it
