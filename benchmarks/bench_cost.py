@@ -13,7 +13,11 @@ engines do the same arithmetic, so they are).
 Run: ``python benchmarks/bench_cost.py [--quick] [--cases rsj,rsf,thf] [--engines before,today]
 [--baseline-python PYTHON] [--threads N] [--time-step-estimate bounds|global]``
 
-"before" differs from "today" by the wall's force kernel only. ``--baseline-python`` names the
+"before" differs from "today" by the wall's force kernel only. "paced" is today's engine with
+the loading-following held push (``held_push_pace`` = 0.9, off by default): it changes the
+answers, so its line also says whether its outputs lie within the rate check's bounds of
+today's (deformations and lag 5 %, peak forces 10 %). ``--half-speed`` runs every case at half
+its push speed: with it, the rate check of each engine is two invocations. ``--baseline-python`` names the
 Python of an environment where an earlier checkout is installed (``pip install -e CHECKOUT`` in a
 venv): each case then also runs there, in a child process (this script under that Python), as
 engine "baseline": the whole engine of that checkout.
@@ -36,7 +40,9 @@ from pathlib import Path
 
 import numba
 
+from colonsim.insertion.case.outcomes import DEFORMATION_TOLERANCE, FORCE_FLOOR_N, FORCE_TOLERANCE
 from colonsim.insertion.case.scenario import InsertionCase, run_insertion
+from colonsim.insertion.study.claims import NO_DEFORMATION_CM
 from colonsim.insertion.engine.shell import Shell
 
 CASES = {
@@ -44,7 +50,12 @@ CASES = {
     "rsf": {"segment": "rsf", "scope": "13.3", "angle_deg": 45.0},
     "thf": {"segment": "thf", "scope": "13.3", "angle_deg": 45.0},
 }
-ENGINES = {"before": "elementwise", "today": "blocked"}  # engine -> Shell.force_kernel
+ENGINES = {"before": "elementwise", "today": "blocked", "paced": "blocked"}  # engine -> Shell.force_kernel
+# engine -> settings it changes: "paced" is today's engine with the loading-following held push
+# (InsertionCase.held_push_pace; docs/model.md, "Distal resistance"), which changes the answers,
+# so its outputs are compared with today's against the rate check's bounds
+PACED = 0.9
+ENGINE_SETTINGS = {"paced": {"held_push_pace": PACED}}
 QUICK = {"element_size_mm": 6.0, "push_speed": 0.6}  # --quick: coarse wall, fast push
 
 
@@ -63,12 +74,30 @@ def outputs(summary):
     }
 
 
-def settings(name, args):
-    """The InsertionCase settings of case ``name`` under the command line's options."""
-    out = dict(CASES[name], time_step_estimate=args.time_step_estimate)
+def settings(name, args, engine=None):
+    """The InsertionCase settings of case ``name`` under the command line's options (and ``engine``'s)."""
+    out = dict(CASES[name], time_step_estimate=args.time_step_estimate, **ENGINE_SETTINGS.get(engine, {}))
     if args.quick:
         out.update(QUICK)
+    if args.half_speed:
+        out["push_speed"] = 0.5 * out.get("push_speed", InsertionCase.push_speed)
     return out
+
+
+def within_rate_bounds(new, old) -> list:
+    """The rate check's outputs where ``new`` departs from ``old`` by more than its bounds
+    (deformations and lag 5 % above 0.1 cm, peak forces 10 % above 0.5 N), with the departure."""
+    beyond = []
+    for column in ("A cm", "C cm", "final cm", "largest cm", "lag cm", "contact N", "push N"):
+        force = column.endswith("N")
+        floor, bound = (FORCE_FLOOR_N, FORCE_TOLERANCE) if force else (NO_DEFORMATION_CM, DEFORMATION_TOLERANCE)
+        a, b = new[column], old[column]
+        if math.isnan(a) and math.isnan(b) or max(abs(a), abs(b)) < floor:
+            continue
+        change = (a - b) / max(abs(b), floor)
+        if not abs(change) <= bound:
+            beyond.append(f"{column.split()[0]} {change:+.1%}")
+    return beyond
 
 
 def run(name, engine, args):
@@ -78,14 +107,15 @@ def run(name, engine, args):
         Shell.force_kernel = ENGINES[engine]
     t0 = time.perf_counter()
     c0 = time.process_time()
-    result = run_insertion(InsertionCase(**settings(name, args)))
+    result = run_insertion(InsertionCase(**settings(name, args, engine)))
     wall, cpu = time.perf_counter() - t0, time.process_time() - c0
     return wall, cpu, outputs(result.summary), result.timeseries.to_csv(index=False)
 
 
 def options(args):
     """The options a child process needs to run the same cases."""
-    return (["--quick"] if args.quick else []) + (["--threads", str(args.threads)] if args.threads else []) + [
+    return (["--quick"] if args.quick else []) + (["--half-speed"] if args.half_speed else []) + (
+        ["--threads", str(args.threads)] if args.threads else []) + [
         "--time-step-estimate", args.time_step_estimate]
 
 
@@ -117,6 +147,8 @@ def main():
     parser.add_argument("--baseline-python", type=Path, default=None,
                         help="the Python of an environment with an earlier checkout installed: each case also runs "
                              "there, in a child process, after this process's runs (engine 'baseline')")
+    parser.add_argument("--half-speed", action="store_true",
+                        help="every case at half its push speed (the rate check's other run)")
     parser.add_argument("--threads", type=int, default=None, help="Numba threads (default: all)")
     parser.add_argument("--time-step-estimate", default=InsertionCase.time_step_estimate, help="bounds or global")
     parser.add_argument("--serve", default=None, help=argparse.SUPPRESS)  # the child of --baseline-python
@@ -150,10 +182,16 @@ def main():
                 print(f"{name:>5} {engine:>8} {wall:8.1f} {cpu:8.1f} " + " ".join(f"{out[c]:10.4g}" for c in columns))
             if "today" in runs:
                 w1, c1, _, ts1 = runs["today"]
-                for other, (w0, c0, _, ts0) in runs.items():
-                    if other != "today":
-                        print(f"{name:>5} today/{other}: wall time ratio {w1 / w0:.3f}, CPU time ratio "
-                              f"{c1 / c0:.3f}; time series {'identical' if ts0 == ts1 else 'DIFFER'}")
+                for other, (w0, c0, out0, ts0) in runs.items():
+                    if other == "today":
+                        continue
+                    same = "identical" if ts0 == ts1 else "DIFFER"
+                    if other in ENGINE_SETTINGS:  # another model setting: judged by the rate check's bounds
+                        beyond = within_rate_bounds(out0, runs["today"][2])
+                        same += "; outputs " + ("within the rate bounds" if not beyond else "BEYOND the rate "
+                                                "bounds: " + ", ".join(beyond))
+                    print(f"{name:>5} today/{other}: wall time ratio {w1 / w0:.3f}, CPU time ratio "
+                          f"{c1 / c0:.3f}; time series {same}")
 
 
 if __name__ == "__main__":

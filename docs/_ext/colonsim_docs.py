@@ -44,6 +44,7 @@ PARAMETERS = {
     "push_speed": ("m/s", NUMERICAL),
     "held_push_share": ("", NUMERICAL),
     "held_push_lead_mm": ("mm", NUMERICAL),
+    "held_push_pace": ("", NUMERICAL),
     "ramp_s": ("s", NUMERICAL),
     "relax_s": ("s", NUMERICAL),
     "relax_max_s": ("s", NUMERICAL),

@@ -138,6 +138,26 @@ class PushProfile:
         if (self.slowed_at is not None or not 0.0 < share < 1.0 or not last.start <= t < last.end
                 or last.speed <= 0.0):
             return False
+        if not self._push_on_at(t, share * last.speed):
+            return False
+        self.slowed_at = t
+        return True
+
+    def change_speed(self, t, speed) -> bool:
+        """From time ``t`` within the held push, push at ``speed`` (m/s) to the same final depth: a
+        new ``held push`` plateau, reached over the profile's ramp (the loading-following held push,
+        ``held_push_pace``; docs/model.md, "Distal resistance"). A closing ``settle`` phase keeps
+        its stop distance and hold. Only after :meth:`slow`; returns whether the profile changed."""
+        last = self.last_push
+        if (self.slowed_at is None or last.name != HELD_PUSH or not last.start <= t < last.end
+                or not speed > 0.0 or speed == last.speed):
+            return False
+        return self._push_on_at(t, speed)
+
+    def _push_on_at(self, t, speed) -> bool:
+        """Replace the last push from time ``t`` by a ``held push`` at ``speed`` to the same final
+        depth (:meth:`slow`, :meth:`change_speed`); False when it has no depth left to push."""
+        last = self.last_push
         settle = self.phases[-1] if self.phases[-1].name == SETTLE else None
         # the slowing to rest covers half its ramp times the speed it starts from
         stop_distance = 0.5 * settle.ramp * self.speed(settle.start) if settle is not None else 0.0
@@ -145,22 +165,21 @@ class PushProfile:
         goal = self.depth(self.duration) - stop_distance  # where the slowing to rest begins
         before = self.phases[:-1] if settle is not None else list(self.phases)
         before[-1] = Phase(last.name, last.start, t, last.speed, last.lateral_constraint, last.ramp)
-        trial = PushProfile(before + [Phase(HELD_PUSH, t, math.inf, share * last.speed)], self.ramp)
+        trial = PushProfile(before + [Phase(HELD_PUSH, t, math.inf, speed)], self.ramp)
         if goal <= trial.depth(t):
             return False
-        # depth rises monotonically; from the plateau the speed stays above share * speed, so the
-        # bracket holds at once; a push still speeding up below it needs a wider one
-        hi = t + (goal - trial.depth(t)) / (share * last.speed)
+        # depth rises monotonically; slowing from the plateau the speed stays above the new one, so
+        # the bracket holds at once; a push speeding up (or still ramping) may need a wider one
+        hi = t + (goal - trial.depth(t)) / speed
         while trial.depth(hi) < goal:
             hi = t + 2.0 * (hi - t)
         end = _solve_time(trial.depth, goal, t, hi)
-        phases = before + [Phase(HELD_PUSH, t, end, share * last.speed)]
+        phases = before + [Phase(HELD_PUSH, t, end, speed)]
         if settle is not None:
             v = trial.speed(end)
             ramp = 2.0 * stop_distance / v
             phases.append(Phase(SETTLE, end, end + ramp + hold, 0.0, ramp=ramp))
         self.phases = phases
-        self.slowed_at = t
         self.__post_init__()
         return True
 

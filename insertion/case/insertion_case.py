@@ -28,7 +28,8 @@ LATER_FIELDS = ("centerline", "centerline_smoothing_mm", "material_parameters", 
 TIME_STEP_ESTIMATES = ("bounds", "global")
 # fields left out of the key at the value that gives the runs of before they existed
 # (a default changed to another value then gives new keys: no run of before is taken for one of it)
-ABSENT_AT = {"distal_resistance_N": 0.0, "held_push_share": 1.0, "held_push_lead_mm": 0.0, "relax_max_s": 0.0,
+ABSENT_AT = {"distal_resistance_N": 0.0, "held_push_share": 1.0, "held_push_lead_mm": 0.0, "held_push_pace": 0.0,
+             "relax_max_s": 0.0,
              "time_step_estimate": "bounds", "contact_surface": "nodes", "stiffness_factor": 1.0}
 
 
@@ -88,6 +89,13 @@ class InsertionCase:
         exit, so the tip meets the resistance already slowed (50; 0: when the resistance engages;
         docs/notes/2026-11-model-studies.md, "The push speed at which the tip meets the resistance" and "The defaults of
         2026-11-28").
+    held_push_pace : float
+        The loading-following held push (0: off, the default; docs/model.md, "Distal resistance"):
+        once the tip is wholly in the resisted exit, the held push returns to ``push_speed`` while
+        the tip keeps pace with the push (over the last centimetre of push it advanced along the
+        lumen by at least this share of the push, e.g. 0.9: it slides through against the
+        resistance and nothing behind it changes) and slows to ``held_push_share`` again when its
+        pace falls :data:`~colonsim.insertion.case.held_push.PACE_HYSTERESIS` below.
     sheath_reserve_mm : float
         Scope length that stays in the sheath at the end of the push (**assumption** 20).
     ramp_s, relax_s : float
@@ -152,6 +160,7 @@ class InsertionCase:
     push_speed: float = 0.15
     held_push_share: float = 0.5
     held_push_lead_mm: float = 50.0
+    held_push_pace: float = 0.0
     ramp_s: float = 0.4
     relax_s: float = 0.1
     relax_max_s: float = 5.0
@@ -196,6 +205,8 @@ class InsertionCase:
              f"share of the push speed behind a held tip ({InsertionCase.held_push_share:g}; 1: not slowed)"),
             ("held_push_lead_mm", self.held_push_lead_mm, 0.0, 500.0,
              f"distance before the fixed exit at which the held push begins, mm ({InsertionCase.held_push_lead_mm:g})"),
+            ("held_push_pace", self.held_push_pace, 0.0, 1.0,
+             "share of the push the tip must keep for the held push to return to the push speed (0: never)"),
             ("colon_damping", self.colon_damping, 0.0, 1e4, "damping in 1/s"),
             ("scope_damping", self.scope_damping, 0.0, 1e4, "damping in 1/s"),
             ("scope_lateral_damping", self.scope_lateral_damping, 0.0, 1e4, "damping in 1/s"),
@@ -284,6 +295,7 @@ class InsertionCase:
         if "distal_resistance_N" not in inputs:  # nothing holds the tip: the held push never starts
             inputs.pop("held_push_share", None)
             inputs.pop("held_push_lead_mm", None)
+            inputs.pop("held_push_pace", None)
         if self.centerline is not None:
             inputs["centerline"] = "sha256:" + load_centerline_points(self.centerline).digest()
         return hashlib.sha256(json.dumps(inputs, sort_keys=True).encode()).hexdigest()[:12]

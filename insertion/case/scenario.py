@@ -21,6 +21,9 @@ Modelling choices (stated so they can be cited):
 - once the tip is held (or, with ``held_push_lead_mm``, that far before the exit), the rest of the
   push goes on at ``held_push_share`` of the push speed, to the same depth
   (:meth:`PushProfile.slow`, the ``held push`` phase; docs/model.md, "Loading");
+- with ``held_push_pace`` > 0, the held push returns to the push speed while the tip slides on
+  through the exit at the push's pace, and slows again when it falls behind
+  (:mod:`colonsim.insertion.case.held_push`);
 - quasi-static runs use mass-proportional damping, by default 60 1/s on the colon (about
   critical for its lowest bending modes of ~10 Hz) and 5 1/s on the scope (its rigid push
   through the sheath would otherwise feel a drag of alpha m v);
@@ -53,6 +56,7 @@ from colonsim.insertion.anatomy.colon_segments import EXIT_LIMIT, colon_geometry
 from colonsim.insertion.anatomy.manoeuvre import RELAX, PushProfile, continuous_push, straighten_relax_push
 from colonsim.insertion.anatomy.scopes import colonoscope
 from colonsim.insertion.case.case_material import case_material
+from colonsim.insertion.case.held_push import paced_speed, tip_pace
 from colonsim.insertion.case.insertion_case import InsertionCase
 from colonsim.insertion.case.lumen_guard import check_scope_inside
 from colonsim.insertion.case.outcomes import REST_TOLERANCE, REST_WINDOW, TURNED_BACK_DEG, rest_drift
@@ -338,6 +342,10 @@ def run_insertion(case: InsertionCase, progress=None, snapshot_interval=None) ->
             slowing = last["tip_arc_m"] > model.geometry.exit_start - case.held_push_lead_mm * 1e-3
             if slowing and not settling and ended_by is None:
                 push.slow(model.solver.time, case.held_push_share)  # once, in the last push (docs/model.md, "Loading")
+            if case.held_push_pace > 0.0 and push.slowed_at is not None and not settling and ended_by is None:
+                pace = tip_pace(recorder.rows, resisted_from=model.geometry.exit_start + DISTAL_RAMP)
+                push.change_speed(model.solver.time, paced_speed(pace, case.held_push_pace, push.last_push.speed,
+                                                                 case.push_speed, case.held_push_share * case.push_speed))
         if ended_by is not None:
             if at_rest and model.solver.time >= push.hold_start + case.settle_s - 1e-12 and came_to_rest(recorder.rows):
                 break
