@@ -1,4 +1,4 @@
-"""Sections of the validation report carried from the previous report (benchmarks/validation_carry.py):
+"""Sections of the validation report carried from the previous report (validation/carry.py):
 a section whose sweep is not given comes from the previous report, marked with where it was computed;
 a section whose sweep is given is never replaced; the Markdown says which is which. Read on the
 landed report itself."""
@@ -9,11 +9,11 @@ import sys
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT / "benchmarks"))
+sys.path.insert(0, str(ROOT))  # the validation package (a tool folder)
 
-import validation_carry as carry  # noqa: E402
-import validation_report  # noqa: E402
-from validation_markdown import write_markdown  # noqa: E402
+from validation import carry  # noqa: E402
+from validation import report as validation_report  # noqa: E402
+from validation.markdown import write_markdown  # noqa: E402
 
 
 
