@@ -86,27 +86,45 @@ def test_no_page_names_a_commit_or_a_machine_path(page):
                        + "\n".join(found))
 
 
-def test_the_report_page_is_what_its_builder_writes_from_report_json(tmp_path, capsys):
-    """docs/validation/report.md is written by the builder from report.json (``--markdown-only``
-    rewrites it without reading a sweep); the page shows the JSON's machine paths and commits as
-    neither."""
-    import shutil
+NOTEBOOK_BYTES = 400_000  # a stored notebook's size at most (the site embeds its figures)
+
+
+def test_the_stored_notebooks_stay_small():
+    sizes = {p.name: p.stat().st_size for p in (ROOT / "notebooks").glob("*.ipynb")}
+    assert len(sizes) == 5 and all(size <= NOTEBOOK_BYTES for size in sizes.values()), sizes
+
+
+def test_storing_outputs_shrinks_figures_and_drops_timestamps():
+    """notebooks/store_outputs.py: a figure becomes a smaller 256-colour PNG of the same size in
+    pixels, the execution timestamps go."""
+    import base64
+    import io
     import sys
 
-    sys.path.insert(0, str(ROOT))
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    import nbformat
+    import numpy as np
+    from PIL import Image
+
+    sys.path.insert(0, str(ROOT / "notebooks"))
     try:
-        from validation import markdown, report
+        import store_outputs
     finally:
-        sys.path.remove(str(ROOT))
-    shutil.copy(DOCS / "validation" / "report.json", tmp_path / "report.json")
-    assert report.main(["--markdown-only", "--out", str(tmp_path)]) == 0
-    assert (tmp_path / "report.md").read_text(encoding="utf-8") == (DOCS / "validation" / "report.md").read_text(encoding="utf-8")
-    assert report.main(["--markdown-only", "--out", str(tmp_path / "none")]) == 2
-    assert "no report.json" in capsys.readouterr().err
-    assert markdown.shown_path("/work/runs/thesis") == "DIR/thesis"
-    assert markdown.shown_path(ROOT / "benchmarks" / "records" / "thesis") == "benchmarks/records/thesis"
-    assert markdown.shown_folder("/elsewhere/thesis") == "`DIR/thesis` (record `benchmarks/records/thesis`)"
-    assert markdown.shown_folder("/elsewhere/no_such_sweep") == "`DIR/no_such_sweep`"
-    assert markdown.shown_command("python -m validation.report --sweep /a/b/thesis --out docs/validation") == \
-        "python -m validation.report --sweep DIR/thesis --out docs/validation"
-    assert markdown.commits({"a" * 40: 3, "b" * 40: 1}) == "rows made by 2 commits of the code"
+        sys.path.remove(str(ROOT / "notebooks"))
+    fig, ax = plt.subplots(figsize=(4, 3))
+    ax.tripcolor(*np.random.default_rng(0).random((3, 200)), cmap="magma_r")
+    png = io.BytesIO()
+    fig.savefig(png, format="png")
+    plt.close(fig)
+    data = base64.b64encode(png.getvalue()).decode("ascii")
+    cell = nbformat.v4.new_code_cell("x", metadata={"execution": {"iopub.status.idle": "2026-12-07T03:40:00Z"}},
+                                     outputs=[nbformat.v4.new_output("display_data", data={"image/png": data})])
+    notebook = nbformat.v4.new_notebook(cells=[cell])
+    store_outputs.tidy(notebook)
+    small = notebook.cells[0].outputs[0]["data"]["image/png"]
+    assert "execution" not in notebook.cells[0].metadata and len(small) < 0.8 * len(data)
+    before, after = (Image.open(io.BytesIO(base64.b64decode(d))) for d in (data, small))
+    assert after.size == before.size and after.mode == "P"

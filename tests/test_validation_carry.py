@@ -111,3 +111,27 @@ def test_carry_without_a_previous_report_is_a_one_line_error_before_anything_is_
     err = capsys.readouterr().err.strip()
     assert "\n" not in err and "--previous OLD/report.json" in err
     assert not (tmp_path / "report.md").exists()
+
+
+def test_the_report_page_is_what_its_builder_writes_from_report_json(tmp_path, capsys):
+    """docs/validation/report.md is written by the builder from report.json (``--markdown-only``
+    rewrites it without reading a sweep); the page shows the JSON's machine paths and commits as
+    neither."""
+    import shutil
+
+    from validation import markdown
+
+    page = ROOT / "docs" / "validation"
+    shutil.copy(page / "report.json", tmp_path / "report.json")
+    assert validation_report.main(["--markdown-only", "--out", str(tmp_path)]) == 0
+    assert (tmp_path / "report.md").read_text(encoding="utf-8") == (page / "report.md").read_text(encoding="utf-8")
+    assert validation_report.main(["--markdown-only", "--out", str(tmp_path / "none")]) == 2
+    assert "no report.json" in capsys.readouterr().err
+    assert markdown.shown_path("/work/runs/thesis") == "DIR/thesis"
+    assert markdown.shown_path(ROOT / "benchmarks" / "records" / "thesis") == "benchmarks/records/thesis"
+    assert markdown.shown_folder("/elsewhere/thesis") == "`DIR/thesis` (record `benchmarks/records/thesis`)"
+    assert markdown.shown_folder("/elsewhere/no_such_sweep") == "`DIR/no_such_sweep`"
+    assert markdown.shown_command("python -m validation.report --sweep /a/b/thesis --out docs/validation") == \
+        "python -m validation.report --sweep DIR/thesis --out docs/validation"
+    assert markdown.commits({"a" * 40: 3, "b" * 40: 1}) == "rows made by 2 commits of the code"
+
