@@ -6,7 +6,7 @@ source's points A and C (docs/model.md, "Reference results").
 Run: ``python benchmarks/bench_insertion.py [--quick] [--threads N] [--time-step-estimate global]
 [--profile]`` (``--quick``: the timed run only; ``--profile``: where the timed run's time goes, by
 job, from the profiler's own time of each function, :data:`JOBS`). The validation report
-(``benchmarks/validation_report.py``) reads the same cases from a sweep.
+(``validation/report.py``) reads the same cases from a sweep.
 """
 
 import argparse

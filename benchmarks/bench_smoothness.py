@@ -5,28 +5,31 @@ Reads sweep folders of the smoothness check's cases (RSJ D36, mu 0, scope 9.0-13
 folder run with other numerical settings: ``benchmarks/sweeps/smoothness.toml``,
 ``smoothness_faces.toml``, ``smoothness_2mm.toml``) and prints, per folder and output, the
 validation report's measure (the largest departure from the least-squares cubic in the
-diameter, as a share of the output's range; :func:`validation_smoothness.cubic_departures`) and
+diameter, as a share of the output's range; :func:`validation.smoothness.cubic_departures`) and
 the largest deformation against the larger of the cubics of A and C
-(:func:`validation_smoothness.larger_of_cubics`: the crease where one overtakes the other, which
+(:func:`validation.smoothness.larger_of_cubics`: the crease where one overtakes the other, which
 no single cubic follows); then, per output, the correlation of the
 departures between every two folders. A departure that the numerical settings do not move
 (correlation near 1) is the model's own shape; one that changes sign with them is scatter.
 
 Run: ``python benchmarks/bench_smoothness.py DIR [DIR ...]`` (folders of ``colonsim sweep``; the
-records unpack to them: ``python benchmarks/sweep_records.py unpack benchmarks/records/NAME DIR``).
+records unpack to them: ``python -m validation.sweep_records unpack benchmarks/records/NAME DIR``).
 """
 
 from __future__ import annotations
 
 import argparse
 import itertools
+import sys
 from pathlib import Path
 
 import numpy as np
 
 from colonsim.insertion.anatomy.scopes import colonoscope
 from colonsim.insertion.study.sweep import read_results
-from validation_smoothness import CUBIC_OUTPUTS, CUBIC_TOLERANCE, cubic_fit, larger_of_cubics
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # the validation package beside benchmarks/
+from validation.smoothness import CUBIC_OUTPUTS, CUBIC_TOLERANCE, cubic_fit, larger_of_cubics  # noqa: E402
 
 
 def departures(folder):

@@ -1,4 +1,4 @@
-"""Markdown tables for the generated reports (``colonsim demo``, ``benchmarks/validation_report.py``)."""
+"""Markdown tables for the generated reports (``colonsim demo``, ``validation/report.py``)."""
 
 from __future__ import annotations
 

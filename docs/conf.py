@@ -1,9 +1,10 @@
 """Sphinx configuration of colonsim's documentation site (MyST Markdown, furo, myst-nb).
 
 Build: ``sphinx-build -W docs docs/_build`` (``pip install -e ".[docs]"``). The notebooks are
-rendered as stored (they are committed without outputs), never executed here (the test command executes them at
-reduced size); the command-line reference is generated from the argparse parser, the results
-columns and the model parameters from the code (``_ext/colonsim_docs.py``).
+rendered with the outputs stored in them (one run at reduced size, docs/tutorials/index.md), never
+executed here (the test command executes them at reduced size); the command-line reference is
+generated from the argparse parser, the results columns and the model parameters from the code
+(``_ext/colonsim_docs.py``).
 """
 
 import sys

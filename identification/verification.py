@@ -4,7 +4,7 @@ bundled synthetic specimens (``data/tensile/ground_truth.json``).
 
 The ``*_check`` functions return the comparisons that the verification table
 (:mod:`colonsim.insertion.study.verification_table`) judges; the recovery is asserted by
-``tests/test_calibration.py`` and reported by ``benchmarks/validation_report.py``. Forces in N,
+``tests/test_calibration.py`` and reported by ``validation/report.py``. Forces in N,
 lengths in m, parameters in Pa.
 """
 

@@ -117,8 +117,43 @@ def test_no_module_imports_the_old_top_level_names():
     old = re.compile(r"^\s*(from|import) (insertion|identification|surrogate)\b", re.M)
     offenders = [str(p.relative_to(ROOT)) for p in MODULES.values() if old.search(p.read_text())]
     offenders += [str(p.relative_to(ROOT)) for p in (ROOT / "tests").glob("*.py") if old.search(p.read_text())]
-    offenders += [str(p.relative_to(ROOT)) for p in (ROOT / "benchmarks").glob("*.py") if old.search(p.read_text())]
+    offenders += [str(p.relative_to(ROOT)) for folder in TOOL_FOLDERS for p in (ROOT / folder).glob("*.py")
+                  if old.search(p.read_text())]
     assert not offenders
+
+
+# The repository's tool folders, not installed (docs/architecture.md): benchmarks/ (scripts) and
+# validation/ (the validation report's builder, a package run as python -m validation.NAME).
+TOOL_FOLDERS = ("benchmarks", "validation")
+
+
+def _absolute_imports(path):
+    """Top-level names ``path`` imports absolutely (at any depth of its code)."""
+    names = set()
+    for node in ast.walk(ast.parse(path.read_text(), str(path))):
+        if isinstance(node, ast.Import):
+            names |= {a.name.split(".")[0] for a in node.names}
+        elif isinstance(node, ast.ImportFrom) and not node.level and node.module:
+            names.add(node.module.split(".")[0])
+    return names
+
+
+def test_tool_folders_are_imported_one_way():
+    """colonsim imports neither tool folder; validation imports colonsim, never a benchmark (a
+    benchmark may import validation)."""
+    benchmarks = {p.stem for p in (ROOT / "benchmarks").glob("*.py")}
+    upward = [f"{m} imports {name}" for m, p in MODULES.items() for name in _absolute_imports(p)
+              if name == "validation" or name in benchmarks]
+    upward += [f"validation/{p.name} imports {name}" for p in (ROOT / "validation").glob("*.py")
+               for name in _absolute_imports(p) if name in benchmarks]
+    assert not upward, upward
+    assert "colonsim" in set().union(*(_absolute_imports(p) for p in (ROOT / "validation").glob("*.py")))
+
+
+@pytest.mark.parametrize("path", sorted((ROOT / "validation").glob("*.py")), ids=lambda p: p.name)
+def test_validation_modules_stay_small(path):
+    lines = len(path.read_text().splitlines())
+    assert lines <= MAX_LINES, f"validation/{path.name}: {lines} lines (> {MAX_LINES}); split it"
 
 
 @pytest.mark.parametrize("module", sorted(MODULES))

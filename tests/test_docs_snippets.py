@@ -5,7 +5,8 @@ command line's ``main``, exit code 0 required), a ``python`` block is executed t
 preceded by ``<!-- check: options -->`` is one whose run is expensive (an insertion at the default
 mesh, a full calibration, a sweep, the demo, a cluster): each of its ``colonsim`` commands is
 parsed by the real parser instead (every option must exist and every value parse), a
-``python FILE`` must name a file of the repository, ``pip install`` extras must exist in
+``python FILE`` must name a file of the repository, a ``python -m validation.NAME`` a tool whose
+``--help`` lists every option given, ``pip install`` extras must exist in
 pyproject.toml, and its Python is compiled. Blocks without a language (printed output, file
 contents) are not code. The folder holds what the commands name: the bundled data under
 ``data/``, a force-displacement ``test.csv``, and a SYNTHETIC sweep table where a sweep's
@@ -71,6 +72,26 @@ def check_pip(words):
         assert not unknown, f"pip install names extras pyproject.toml does not define: {unknown}"
 
 
+def check_tool_options(module, args):
+    """``python -m validation.NAME ARGS``: the module exists and its help names every ``--option`` given."""
+    import contextlib
+    import importlib
+    import io
+
+    assert module.startswith("validation.") and (ROOT / (module.replace(".", "/") + ".py")).is_file(), \
+        f"python -m {module}: not a tool of the repository (validation/)"
+    sys.path.insert(0, str(ROOT))
+    try:
+        tool = importlib.import_module(module)
+    finally:
+        sys.path.remove(str(ROOT))
+    text = io.StringIO()
+    with contextlib.redirect_stdout(text), pytest.raises(SystemExit):
+        tool.main(["--help"])
+    unknown = [a.split("=")[0] for a in args if a.startswith("--") and a.split("=")[0] not in text.getvalue()]
+    assert not unknown, f"python -m {module}: options its --help does not list: {unknown}"
+
+
 def run_command(words, options_only):
     program = words[0]
     if program == "colonsim":
@@ -85,6 +106,9 @@ def run_command(words, options_only):
         check_pip(words)
     elif program == "python" and words[1:3] == ["-m", "pytest"]:
         pass  # the test command: it is what runs this file
+    elif program == "python" and words[1:2] == ["-m"]:
+        assert options_only, f"{shlex.join(words)}: a tool of the repository in a block that runs; mark it options-only"
+        check_tool_options(words[2], words[3:])
     elif program == "python":
         assert options_only, f"{shlex.join(words)}: a benchmark or script in a block that runs; mark it options-only"
         assert (ROOT / words[1]).is_file(), f"{words[1]} does not exist"
@@ -136,4 +160,7 @@ def test_an_unknown_option_in_a_block_fails():
         run_command(shlex.split("python benchmarks/no_such_benchmark.py"), options_only=True)
     with pytest.raises(AssertionError):
         check_pip(shlex.split('pip install -e ".[no_such_extra]"'))
+    with pytest.raises(AssertionError, match="--no-such-option"):
+        run_command(shlex.split("python -m validation.report --sweep S --no-such-option"), options_only=True)
+    run_command(shlex.split("python -m validation.report --sweep S --markdown-only"), options_only=True)
     run_command(shlex.split("colonsim insert --segment rsj --scope sdc"), options_only=True)

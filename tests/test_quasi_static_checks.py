@@ -1,4 +1,4 @@
-"""benchmarks/quasi_static_checks.py: one line per quasi-static criterion, and the mesh pair, the rate
+"""validation/quasi_static_checks.py: one line per quasi-static criterion, and the mesh pair, the rate
 check and the smoothness checks of any sweeps as the validation report's own (on the committed
 records of the report's sweeps, the verdicts of docs/validation/report.json); a missing or
 half-given sweep is one line, exit 2."""
@@ -13,10 +13,10 @@ from pathlib import Path
 import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT / "benchmarks"))
+sys.path.insert(0, str(ROOT))  # the validation package (a tool folder)
 
-import quasi_static_checks  # noqa: E402
-import sweep_records as records  # noqa: E402
+from validation import quasi_static_checks  # noqa: E402
+from validation import sweep_records as records  # noqa: E402
 
 REPORT = json.loads((ROOT / "docs" / "validation" / "report.json").read_text(encoding="utf-8"))
 

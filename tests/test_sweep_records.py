@@ -1,4 +1,4 @@
-"""Sweep records (benchmarks/sweep_records.py): a sweep folder packed and unpacked again gives the
+"""Sweep records (validation/sweep_records.py): a sweep folder packed and unpacked again gives the
 report the same table, summaries, time series (to the record's quantum) and final shapes; a record
 grows run by run; the report never asks a sweep for a column a record leaves out; bad folders are
 one line."""
@@ -13,10 +13,10 @@ import pandas as pd
 import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT / "benchmarks"))
+sys.path.insert(0, str(ROOT))  # the validation package (a tool folder)
 
-import sweep_records as records  # noqa: E402
-from validation_sweeps import Sweep  # noqa: E402
+from validation import sweep_records as records  # noqa: E402
+from validation.sweeps import Sweep  # noqa: E402
 
 from colonsim.errors import ColonsimError  # noqa: E402
 from colonsim.insertion.case.insertion_case import InsertionCase  # noqa: E402
@@ -157,7 +157,7 @@ def test_bad_folders_are_one_line(tmp_path, capsys):
 
 def test_every_column_the_report_reads_is_recorded():
     asked = set()
-    for path in (ROOT / "benchmarks").glob("validation_*.py"):
+    for path in (ROOT / "validation").glob("*.py"):
         for call in re.findall(r"\.timeseries\(\s*row\s*,\s*\[([^\]]*)\]", path.read_text(encoding="utf-8")):
             asked |= set(re.findall(r"\"([^\"]+)\"", call))
     assert asked, "the report's modules ask a sweep for time-series columns"

@@ -1,4 +1,4 @@
-"""Sections of the validation report carried from the previous report (benchmarks/validation_carry.py):
+"""Sections of the validation report carried from the previous report (validation/carry.py):
 a section whose sweep is not given comes from the previous report, marked with where it was computed;
 a section whose sweep is given is never replaced; the Markdown says which is which. Read on the
 landed report itself."""
@@ -9,11 +9,11 @@ import sys
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT / "benchmarks"))
+sys.path.insert(0, str(ROOT))  # the validation package (a tool folder)
 
-import validation_carry as carry  # noqa: E402
-import validation_report  # noqa: E402
-from validation_markdown import write_markdown  # noqa: E402
+from validation import carry  # noqa: E402
+from validation import report as validation_report  # noqa: E402
+from validation.markdown import write_markdown  # noqa: E402
 
 
 
@@ -111,3 +111,27 @@ def test_carry_without_a_previous_report_is_a_one_line_error_before_anything_is_
     err = capsys.readouterr().err.strip()
     assert "\n" not in err and "--previous OLD/report.json" in err
     assert not (tmp_path / "report.md").exists()
+
+
+def test_the_report_page_is_what_its_builder_writes_from_report_json(tmp_path, capsys):
+    """docs/validation/report.md is written by the builder from report.json (``--markdown-only``
+    rewrites it without reading a sweep); the page shows the JSON's machine paths and commits as
+    neither."""
+    import shutil
+
+    from validation import markdown
+
+    page = ROOT / "docs" / "validation"
+    shutil.copy(page / "report.json", tmp_path / "report.json")
+    assert validation_report.main(["--markdown-only", "--out", str(tmp_path)]) == 0
+    assert (tmp_path / "report.md").read_text(encoding="utf-8") == (page / "report.md").read_text(encoding="utf-8")
+    assert validation_report.main(["--markdown-only", "--out", str(tmp_path / "none")]) == 2
+    assert "no report.json" in capsys.readouterr().err
+    assert markdown.shown_path("/work/runs/thesis") == "DIR/thesis"
+    assert markdown.shown_path(ROOT / "benchmarks" / "records" / "thesis") == "benchmarks/records/thesis"
+    assert markdown.shown_folder("/elsewhere/thesis") == "`DIR/thesis` (record `benchmarks/records/thesis`)"
+    assert markdown.shown_folder("/elsewhere/no_such_sweep") == "`DIR/no_such_sweep`"
+    assert markdown.shown_command("python -m validation.report --sweep /a/b/thesis --out docs/validation") == \
+        "python -m validation.report --sweep DIR/thesis --out docs/validation"
+    assert markdown.commits({"a" * 40: 3, "b" * 40: 1}) == "rows made by 2 commits of the code"
+

@@ -1,13 +1,13 @@
 """The validation report's section on what moved since the previous report
-(benchmarks/validation_changes.py): runs matched by what they are, not by key; a change is listed
+(validation/changes.py): runs matched by what they are, not by key; a change is listed
 only when it is one; a pass/fail that flipped is shown."""
 
 import sys
 from pathlib import Path
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "benchmarks"))
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # the validation package
 
-import validation_changes as changes  # noqa: E402
+from validation import changes  # noqa: E402
 
 
 def report(final_rsf, max_rsf, rate_change, key):
@@ -96,14 +96,20 @@ def test_a_claim_whose_verdict_flipped_is_listed_and_counted_and_an_unchanged_on
 
 
 def test_each_previous_sweep_is_named_with_its_code_or_as_not_run_and_its_carried_sections_are_named():
+    """The section's JSON keeps the previous report's commits; its page names none of them (a test of
+    the site scans the pages for commits), only the sweeps that did not run there."""
     before, after = report(0.96, 1.83, 0.071, "86cc17389552"), report(1.54, 1.834, 0.002, "0f0f0f0f0f0f")
     before["header"]["sweeps"] = {"main": {"code": {"a" * 40: 39}}, "resistance": {"code": {}}}
-    text = "\n".join(changes.markdown(changes.changes(before, after)))
-    assert f"main: `{'a' * 12}`" in text
-    assert "resistance: not run there)" in text and "resistance: ;" not in text and "carried" not in text
+    section = changes.changes(before, after)
+    assert section["previous"]["commit"] == "c" * 40 and section["previous"]["sweeps"]["main"] == {"a" * 40: 39}
+    text = "\n".join(changes.markdown(section))
+    assert "a" * 7 not in text and "c" * 7 not in text and "`changes.previous` in report.json" in text
+    assert "sweeps not run there: resistance)" in text and "carried" not in text
+    before["header"]["sweeps"]["resistance"] = {"code": {"b" * 40: 1}}
+    assert "not run there" not in "\n".join(changes.markdown(changes.changes(before, after)))
     before["header"]["carried"] = ["resistance"]
     text = "\n".join(changes.markdown(changes.changes(before, after)))
-    assert "resistance: not run there; sections it carried from an earlier report: resistance)" in text
+    assert "; sections it carried from an earlier report: resistance)" in text
 
 
 def test_a_quantity_below_its_floor_is_not_counted_as_compared():

@@ -1,4 +1,4 @@
-"""The proposed ringing bound of the validation report (benchmarks/validation_resistance.py): a run
+"""The proposed ringing bound of the validation report (validation/resistance.py): a run
 above the ringing limit counts as quasi-static when half the push speed lowers its ratio by less
 than 20 % and its rate pair passes. Each way it can come out, on made-up table rows."""
 
@@ -9,9 +9,9 @@ from pathlib import Path
 import pandas as pd
 import pytest
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "benchmarks"))
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # the validation package
 
-import validation_resistance as resistance  # noqa: E402
+from validation import resistance  # noqa: E402
 from colonsim.insertion.case.insertion_case import InsertionCase  # noqa: E402
 from colonsim.insertion.study.sweep_presets import HALF_SPEED  # noqa: E402
 
@@ -87,10 +87,10 @@ class TableSweep:
 
 
 def test_the_half_speed_sweep_holds_the_runs_above_the_limit_and_reads_back_as_their_twins():
-    """benchmarks/ringing_half_speed.py: a run at or above the limit is written, one below it, a
+    """validation/ringing_half_speed.py: a run at or above the limit is written, one below it, a
     failed one and one already at half the speed are not; the TOML parses to the keys the report
     looks up (every input that differs from the defaults, the resistance of 0 N included)."""
-    import ringing_half_speed as generator
+    from validation import ringing_half_speed as generator
     from colonsim.insertion.case.ringing import RINGING_LIMIT
     from colonsim.insertion.study.sweep_spec import parse_sweep
 

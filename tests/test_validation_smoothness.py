@@ -1,4 +1,4 @@
-"""The smoothness check's scale (benchmarks/validation_smoothness.py): what the largest departure
+"""The smoothness check's scale (validation/smoothness.py): what the largest departure
 from a cubic in the scope diameter is when the runs only scatter about a smooth trend."""
 
 import sys
@@ -6,9 +6,9 @@ from pathlib import Path
 
 import numpy as np
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "benchmarks"))
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # the validation package
 
-import validation_smoothness as smoothness  # noqa: E402
+from validation import smoothness  # noqa: E402
 
 DIAMETERS = np.arange(9.0, 13.51, 0.5)  # benchmarks/sweeps/smoothness.toml
 
@@ -33,6 +33,7 @@ def test_the_larger_of_two_cubics_follows_the_crease_a_cubic_cannot(tmp_path):
     departure within A itself fails both."""
     import pandas as pd
 
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "benchmarks"))
     import bench_smoothness
 
     a = 0.25 * DIAMETERS - 1.2  # rises through c
@@ -62,7 +63,7 @@ def test_the_report_row_of_the_crease_passes_a_crease_and_fails_a_step(tmp_path)
     against the larger of their cubics while the plain cubic fails it; a step in A fails both."""
     import pandas as pd
 
-    from validation_sweeps import Sweep
+    from validation.sweeps import Sweep
 
     a = 0.25 * DIAMETERS - 1.2
     c = 1.45 + 0.02 * (DIAMETERS - 9.0)

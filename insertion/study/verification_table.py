@@ -2,7 +2,7 @@
 model, listed once with how it is computed, the rule it must meet and why that tolerance holds.
 
 ``tests/test_verification_table.py`` runs each row (at the CI size, or at full size with
-``COLONSIM_FULL=1``) and ``benchmarks/validation_report.py`` renders the table. Adding a check is
+``COLONSIM_FULL=1``) and ``validation/report.py`` renders the table. Adding a check is
 one :class:`Check` entry in ``CHECKS``; the problems themselves live in the ``verification_*``
 modules and :mod:`colonsim.identification.verification`. Ids are ``group.name``.
 """

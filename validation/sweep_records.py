@@ -21,14 +21,14 @@ for the 39), against 1.4 / 3.8 MB for an RSJ / RSF run folder.
 
 Use::
 
-    python benchmarks/sweep_records.py pack SWEEP_DIR RECORD_DIR     # add SWEEP_DIR's finished runs
-    python benchmarks/sweep_records.py unpack RECORD_DIR SWEEP_DIR   # a sweep folder again
-    python benchmarks/sweep_records.py status [RECORDS_DIR]          # what each record holds
+    python -m validation.sweep_records pack SWEEP_DIR RECORD_DIR     # add SWEEP_DIR's finished runs
+    python -m validation.sweep_records unpack RECORD_DIR SWEEP_DIR   # a sweep folder again
+    python -m validation.sweep_records status [RECORDS_DIR]          # what each record holds
 
 ``pack`` adds the finished runs of a sweep folder to a record (a new record, or one of the same
 sweep: the same ``sweep.json``), keeping the runs the record has that the folder lacks. ``unpack``
 writes a sweep folder that ``colonsim sweep`` resumes (the cases in the record are not run
-again) and that ``validation_report.py`` reads as it reads the folder the runs were made in; its
+again) and that ``python -m validation.report`` reads as it reads the folder the runs were made in; its
 time series hold :data:`SERIES_COLUMNS` only. So the report's sweeps go: unpack, run the sweep on
 (resuming), pack, commit the record; once a sweep is complete the report is made from its
 unpacked folder.
@@ -52,6 +52,8 @@ from colonsim.insertion.case.results import RUN_SERIES, RUN_SHAPE, RUN_SUMMARY, 
 from colonsim.provenance import code_version
 from colonsim.insertion.study.sweep import SWEEP_DOCUMENT, TABLE, read_results
 
+# the committed records (one folder per sweep)
+RECORDS = Path(__file__).resolve().parents[1] / "benchmarks" / "records"
 # the time-series columns the validation report reads (tests/test_sweep_records.py checks that
 # every column the report's modules ask a sweep for is here)
 SERIES_COLUMNS = ("phase", "depth_cm", "deformation_cm", "tip_arc_cm", "push_force_N", "contact_nodes")
@@ -191,7 +193,7 @@ def pack(sweep_dir, record_dir) -> dict:
 def unpack(record_dir, sweep_dir) -> dict:
     """Write the record ``record_dir`` as a sweep folder ``sweep_dir`` (new, or one of the same
     sweep: its rows and run folders of the record's runs are replaced). Returns the counts."""
-    record, sweep, table, have = _folders(record_dir, sweep_dir, "a record folder written by `sweep_records.py pack`")
+    record, sweep, table, have = _folders(record_dir, sweep_dir, "a record folder written by `python -m validation.sweep_records pack`")
     rows = []
     with output_set(sweep / "runs") as stage:
         for row in table.to_dict("records"):
@@ -214,7 +216,7 @@ def status(record_dir) -> dict:
     and the commits that made them."""
     record = Path(record_dir)
     if not (record / TABLE).is_file():
-        raise ColonsimError(f"no {TABLE} in {record}; give a record folder written by `sweep_records.py pack`")
+        raise ColonsimError(f"no {TABLE} in {record}; give a record folder written by `python -m validation.sweep_records pack`")
     table, document = read_results(record), _sweep_document(record) or {}
     return {"record": record.name, "sweep": document.get("name"), "defined": len(document.get("keys", ())) or None,
             "ok": int((table["status"] == "ok").sum()), "failed": int((table["status"] != "ok").sum()),
@@ -231,7 +233,7 @@ def main(argv=None) -> int:
     u.add_argument("record")
     u.add_argument("sweep")
     st = sub.add_parser("status", help="what the records in a folder hold")
-    st.add_argument("records", nargs="?", default=str(Path(__file__).resolve().parent / "records"))
+    st.add_argument("records", nargs="?", default=str(RECORDS))
     args = parser.parse_args(argv)
     try:
         if args.command == "status":

@@ -13,8 +13,8 @@ import math
 from colonsim.insertion.study.claims import NOT_REPRODUCED, advantage
 from colonsim.insertion.study.reference import SOURCE_RSJ_CM
 
-from validation_sections import rsj_facts
-from validation_sweeps import find_case
+from .sections import rsj_facts
+from .sweeps import find_case
 
 ENDS = {"tip_past_end": "the tip 2 cm past the junction", "far_end": "the tip at the far end of the exit",
         "length_used": "the scope's available length pushed in", "jam": "a jam"}

@@ -1,6 +1,6 @@
 """The numbers of the validation report's sweep sections, as JSON-ready rows.
 
-Each function reads one or both sweeps (:mod:`benchmarks.validation_sweeps`) and returns plain
+Each function reads one or both sweeps (:mod:`validation.sweeps`) and returns plain
 dicts (cm, N, s); the Markdown is written from the same dicts, so the two never disagree.
 """
 
@@ -18,7 +18,7 @@ from colonsim.insertion.anatomy.colon_segments import colon_geometry
 from colonsim.insertion.study.reference import SOURCE_MESHES, SOURCE_RSJ_CM, SOURCE_RUN_MINUTES
 from colonsim.insertion.case.scenario import InsertionCase
 
-from validation_sweeps import SCOPES, find_case, paired, relative_change, role, scope_label
+from .sweeps import SCOPES, find_case, paired, relative_change, role, scope_label
 
 RSJ_DIAMETERS = (23.0, 36.0)
 # Wall nodes of the source's colon meshes, where it gives them.

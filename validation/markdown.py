@@ -2,15 +2,47 @@
 
 from __future__ import annotations
 
+import shlex
+from pathlib import Path
 
 from colonsim.files import atomic_path
 from colonsim.insertion.case.run_summary import ENDINGS
 from colonsim.insertion.study.verification_rules import GROUPS
 from colonsim.markdown import NOT_RUN, md_table, num, percent
-from validation_carry import carried_lines
-from validation_changes import markdown as changes_markdown
-from validation_markdown_checks import mesh_pair, rate_check, ringing, smoothness, verdict
-from validation_resistance import markdown as resistance_markdown
+from .carry import carried_lines
+from .changes import markdown as changes_markdown
+from .markdown_checks import mesh_pair, rate_check, ringing, smoothness, verdict
+from .resistance import markdown as resistance_markdown
+from .sweep_records import RECORDS
+
+ROOT = RECORDS.parents[1]
+# a folder outside the repository, as the page names it (the JSON keeps the machine's path)
+OUTSIDE = "DIR"
+
+
+def shown_path(path) -> str:
+    """``path`` as the page names it: relative to the repository, or, outside it, as DIR/NAME, so
+    that no page names a build machine's folders (report.json keeps them as given)."""
+    path = Path(path)
+    if not path.is_absolute():
+        return path.as_posix()
+    return path.relative_to(ROOT).as_posix() if path.is_relative_to(ROOT) else f"{OUTSIDE}/{path.name}"
+
+
+def shown_folder(folder) -> str:
+    """A sweep folder as the page names it, with the committed record of the same name if there is one."""
+    record = RECORDS / Path(folder).name
+    return f"`{shown_path(folder)}`" + (f" (record `{record.relative_to(ROOT).as_posix()}`)" if record.is_dir() else "")
+
+
+def shown_command(command) -> str:
+    """The command that made the report, its paths as :func:`shown_path` names them."""
+    return " ".join(shown_path(word) if word.startswith("/") else word for word in shlex.split(command))
+
+
+def commits(counts) -> str:
+    """How many commits of the code made a sweep's rows (report.json names them)."""
+    return f"rows made by {len(counts)} commit{'s' if len(counts) != 1 else ''} of the code" if counts else "-"
 
 
 def header(doc):
@@ -24,20 +56,22 @@ def header(doc):
         if s["folder"] is None:
             return f"{NOT_RUN} (not given: --validation-sweep)"
         if not s["ran"]:
-            return f"`{s['folder']}`: {NOT_RUN} (no results table)"
-        code = ", ".join(f"`{c[:12]}`: {n}" for c, n in s["code"].items()) or "-"
+            return f"{shown_folder(s['folder'])}: {NOT_RUN} (no results table)"
         estimate = ", ".join(f"{k} ({n})" for k, n in (s.get("time_step_estimate") or {}).items()) or "-"
         rules = ", ".join(f"{k} ({n})" for k, n in (s.get("rules") or {}).items()) or "-"
-        return (f"`{s['folder']}`: {s['in_table']} of the {s['defined']} runs it defines in the table ({s['ok']} ok, "
-                f"{s['failed']} failed); code that produced the rows (commit: rows): {code}; time-step estimate of "
-                f"its runs: {estimate}; run rules: {rules}")
+        return (f"{shown_folder(s['folder'])}: {s['in_table']} of the {s['defined']} runs it defines in the table "
+                f"({s['ok']} ok, {s['failed']} failed); {commits(s['code'])}; time-step estimate of its runs: "
+                f"{estimate}; run rules: {rules}")
 
     return [
         "# colonsim validation report", "",
         f"- date: {h['date']}",
-        f"- git commit: `{h['commit']}` ({h['commit_note']})",
+        f"- code: one commit of the repository ({h['commit_note']}); the commits of the report and of every "
+        "sweep's rows are in `report.json` (`header`)",
         f"- machine: {h['machine']}",
-        f"- command: `{h['command']}`",
+        f"- command (from the repository's root; {OUTSIDE}: a folder outside it, e.g. a record unpacked with "
+        f"`python -m validation.sweep_records unpack benchmarks/records/NAME {OUTSIDE}/NAME`): "
+        f"`{shown_command(h['command'])}`",
         f"- main sweep: {sweep_line(h['sweeps']['main'])}",
         f"- validation sweep: {sweep_line(h['sweeps']['validation'])}",
         *([f"- sections carried from the previous report (their sweeps not given; each says so under its heading): "
@@ -155,7 +189,7 @@ def claims(claim_list):
              "runs present and at least one comparison fails. NOT EVALUATED: a run the criterion needs is missing "
              "or failed; nothing is inferred from the runs present. Deformations in cm; reductions and advantages "
              "are fractions of the SDC's deformation. Where a claim fails, the reading below it is built from the "
-             "runs' numbers (`benchmarks/validation_readings.py`).", "",
+             "runs' numbers (`validation/readings.py`).", "",
              "| claim | verdict | comparisons that hold |", "|---|---|---|"]
     lines += [f"| 4.{k} {cl['statement']} | {cl['verdict']} | {tally(cl)} |" for k, cl in enumerate(claim_list, start=1)]
     lines += [""]

@@ -1,5 +1,5 @@
 """Readings of the source's claims across the distal-resistance levels: sentences built from the
-``resistance`` sweep's numbers only (the rows of :func:`validation_resistance.resistance_section`).
+``resistance`` sweep's numbers only (the rows of :func:`validation.resistance.resistance_section`).
 
 For every claim that is not reproduced at any level, a reading says what the runs did at each
 level with the quantities that decide it: the scopes' lag (pushed depth minus the tip's advance,

@@ -5,9 +5,9 @@ the limit by the proposed bound (docs/notes/2026-11-model-studies.md, "Ringing t
 run at half the push speed. Which runs ring depends on the engine that made the sweep, so the list
 is written from the sweep's own table rather than kept by hand::
 
-    python benchmarks/ringing_half_speed.py /path/to/resistance_sweep
+    python -m validation.ringing_half_speed /path/to/resistance_sweep
     colonsim sweep benchmarks/sweeps/ringing_half_speed.toml --workers 2 --out DIR
-    python benchmarks/validation_report.py ... --resistance-sweep /path/to/resistance_sweep --ringing-half-sweep DIR
+    python -m validation.report ... --resistance-sweep /path/to/resistance_sweep --ringing-half-sweep DIR
 
 Each run is written as one ``[[grid]]`` block with every input that differs from the defaults and
 ``push_speed`` at the rate check's half speed, so its key is the one the report looks up.
@@ -25,10 +25,10 @@ from colonsim.insertion.case.insertion_case import InsertionCase
 from colonsim.insertion.case.ringing import RINGING_LIMIT
 from colonsim.insertion.study.sweep_presets import HALF_SPEED
 from colonsim.insertion.study.sweep_spec import parse_sweep
-from validation_resistance import half_speed_twin, measured_ringing
-from validation_sweeps import read_sweep
+from .resistance import half_speed_twin, measured_ringing
+from .sweeps import read_sweep
 
-OUT = Path(__file__).resolve().parent / "sweeps" / "ringing_half_speed.toml"
+OUT = Path(__file__).resolve().parents[1] / "benchmarks" / "sweeps" / "ringing_half_speed.toml"
 
 
 def ringing_cases(sweep) -> list:

@@ -10,7 +10,7 @@ speed) of one case per model. Runs missing from the table are listed, never fill
 
 The runs that ring above the limit are listed with what their ringing is made of and, given a sweep
 of the same runs at half the push speed (``benchmarks/sweeps/ringing_half_speed.toml``, written
-from the resistance sweep by ``benchmarks/ringing_half_speed.py``, passed as
+from the resistance sweep by ``validation/ringing_half_speed.py``, passed as
 ``--ringing-half-sweep DIR``), with the proposed bound's verdict (docs/notes/2026-11-model-studies.md, "Ringing that no
 push speed removes"): half the speed lowers the ratio by less than :data:`BOUND_RATIO_FALL` and
 the rate pair passes.
@@ -28,10 +28,10 @@ from colonsim.insertion.case.ringing import RINGING_LIMIT, ringing_at_drops, rin
 from colonsim.insertion.study.claims import evaluate_claims
 from colonsim.insertion.study.sweep_presets import HALF_SPEED
 from colonsim.markdown import NOT_RUN, md_table, num
-from validation_carry import carried_lines
-from validation_resistance_readings import claim_readings
-from validation_sections import PAIR_QUANTITIES, case_geometry, pair_quantities
-from validation_sweeps import role, scope_label
+from .carry import carried_lines
+from .resistance_readings import claim_readings
+from .sections import PAIR_QUANTITIES, case_geometry, pair_quantities
+from .sweeps import role, scope_label
 
 LEVELS_N = (0.0, 5.0, 10.0, 20.0)
 SHAPES_LEVEL_N = 10.0  # the level whose final shapes the section draws (the issue's "typical")
@@ -203,7 +203,7 @@ def ringing_bound(row, half, case) -> dict:
 
 def rate_changes(base, variant, segment) -> dict:
     """The rate pair of the run ``base`` of ``segment`` and its half-speed run ``variant``, judged as
-    the main sweep's pairs are (:func:`validation_sections.pair_quantities`): ``changes``, column ->
+    the main sweep's pairs are (:func:`validation.sections.pair_quantities`): ``changes``, column ->
     relative change (None below the quantity's floor), tolerance and verdict; and ``passed``."""
     quantities, passed = pair_quantities(base, variant, segment, "rate")
     return {"changes": {q["column"]: {"change": None if not np.isfinite(q["change"]) else q["change"],
@@ -267,7 +267,7 @@ def _remainder_lines(remainder) -> list:
              "(`outcomes.ringing_at_drops`)")
     if not remainder.get("half_ran"):
         return [intro + ":", "", md_table(remainder["above"], columns), "",
-                f"The proposed bound: {NOT_RUN}: no --ringing-half-sweep (`python benchmarks/ringing_half_speed.py "
+                f"The proposed bound: {NOT_RUN}: no --ringing-half-sweep (`python -m validation.ringing_half_speed "
                 "RESISTANCE_SWEEP`, then `colonsim sweep benchmarks/sweeps/ringing_half_speed.toml --out DIR`).", ""]
     judged = [r for r in remainder["above"] if r["bound"] is not None]
     held = [r for r in judged if r["bound"]]

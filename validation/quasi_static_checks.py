@@ -4,15 +4,15 @@ smoothness checks.
 
 On the committed sweep records (unpacked into a temporary folder, read only)::
 
-    python benchmarks/quasi_static_checks.py --records                 # the report's sweeps
-    python benchmarks/quasi_static_checks.py --records --set global    # the same cases at the global estimate
+    python -m validation.quasi_static_checks --records                 # the report's sweeps
+    python -m validation.quasi_static_checks --records --set global    # the same cases at the global estimate
 
 On sweep folders of your own, for a setting the records do not hold::
 
     export NUMBA_NUM_THREADS=1
     colonsim sweep benchmarks/sweeps/checks_global_base.toml --out BASE
     colonsim sweep benchmarks/sweeps/checks_global_variants.toml --out VARIANTS
-    python benchmarks/quasi_static_checks.py --base BASE --variants VARIANTS [--smoothness S] \\
+    python -m validation.quasi_static_checks --base BASE --variants VARIANTS [--smoothness S] \\
         [--gp-train T --gp-test H [--replicates R]] [--ringing SWEEP ...]
 
 A variant pairs with the base run it differs from in its push speed or wall mesh alone. Rows of
@@ -28,18 +28,17 @@ from pathlib import Path
 
 import numpy as np
 
-import validation_smoothness as smoothness
-from sweep_records import unpack
-from validation_markdown_checks import mesh_pair, rate_check
-from validation_markdown_checks import smoothness as smoothness_section
-from validation_report import pair_section, rate_section
-from validation_sections import ringing_rows
-from validation_sweeps import TABLE, read_sweep
+from . import smoothness
+from .sweep_records import RECORDS, unpack
+from .markdown_checks import mesh_pair, rate_check
+from .markdown_checks import smoothness as smoothness_section
+from .report import pair_section, rate_section
+from .sections import ringing_rows
+from .sweeps import TABLE, read_sweep
 
 from colonsim.catalog import TIP_FOLDED
 from colonsim.insertion.case.insertion_case import InsertionCase
 
-RECORDS = Path(__file__).resolve().parent / "records"
 # the records each set reads, by role (the replicates measure the runs' own scatter at the bounds)
 SETS = {"report": {"base": "thesis", "variants": "validation", "smoothness": "smoothness", "gp_train": "gp_train",
                    "gp_test": "gp_test", "replicates": "gp_replicates", "ringing": ("thesis", "validation", "resistance")},
@@ -55,7 +54,7 @@ def _missing(args):
         folder = getattr(args, name)
         if folder is not None and not (Path(folder) / TABLE).is_file():
             return (f"no {TABLE} in {folder}; run `colonsim sweep SWEEP.toml --out {folder}` first "
-                    "(python benchmarks/quasi_static_checks.py --help)")
+                    "(python -m validation.quasi_static_checks --help)")
     pairs = (args.base, args.variants), (args.gp_train, args.gp_test)
     if any((a is None) != (b is None) for a, b in pairs):
         return "give --base with --variants and --gp-train with --gp-test"

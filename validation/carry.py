@@ -1,7 +1,7 @@
 """Sections of the validation report carried from the previous report when their sweep is not given.
 
 The report's sweeps take about ten hours of two cores (the distal resistance sweep alone half of
-that), more than one sitting of the machine that runs them. ``validation_report.py --previous
+that), more than one sitting of the machine that runs them. ``python -m validation.report --previous
 OLD/report.json --carry`` regenerates what the given sweeps can give and takes every section whose
 sweep was not given from OLD/report.json as it stands, instead of saying NOT RUN. A carried section
 is marked with the report it comes from (date, commit) and the code that made its rows, and the
@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import copy
 
-from validation_changes import section_at
+from .changes import section_at
 
 # sweep label -> the report document's sections computed from that sweep (paths into the document)
 SECTIONS = {
@@ -83,7 +83,6 @@ def carried_lines(section) -> list:
     mark = (section or {}).get("carried_from")
     if not mark:
         return []
-    code = ", ".join(f"`{c[:12]}`: {n}" for c, n in (mark.get("rows_code") or {}).items())
-    return [f"*Carried from the report of {mark.get('date')} (commit `{str(mark.get('commit'))[:12]}`): its sweep "
-            "was not given to this report" + (f"; code that made its rows (commit: rows): {code}" if code else "")
-            + ". Not recomputed at this commit.*", ""]
+    return [f"*Carried from the report of {mark.get('date')}: its sweep was not given to this report. Not "
+            "recomputed by this report's code (the commits of that report and of the sweep's rows: "
+            "`carried_from` in report.json).*", ""]

@@ -4,7 +4,7 @@ key moves with every setting that enters it, so the same case at a new default h
 The distal resistance sweep's runs (by model, scope, angle or diameter and level), its rate pairs
 and the source's claims reproduced per level are compared too, where both reports have them.
 
-``validation_report.py --previous OLD/report.json`` adds the section; without it the section
+``python -m validation.report --previous OLD/report.json`` adds the section; without it the section
 says NOT RUN. Copy the landed report's JSON aside first, since the new report replaces it:
 ``git show HEAD:docs/validation/report.json > /tmp/previous_report.json``.
 """
@@ -217,11 +217,13 @@ def markdown(section) -> list:
         return lines + [f"{NOT_RUN}: {(section or {}).get('note', '')}", ""]
     p = section["previous"]
     n_resisted = sum(r.get("sweep") == "resistance" for r in section["runs"])
-    code = "; ".join(f"{k}: " + (", ".join(f"`{c[:12]}`" for c in v) if v else "not run there")
-                     for k, v in p["sweeps"].items())
+    code = "its commit and its sweeps' code: `changes.previous` in report.json"
+    absent = [k for k, v in p["sweeps"].items() if not v]
+    if absent:
+        code += f"; sweeps not run there: {', '.join(absent)}"
     if p.get("carried"):
         code += f"; sections it carried from an earlier report: {', '.join(p['carried'])}"
-    lines += [f"Against the report of {p['date']} (commit `{(p['commit'] or '')[:12]}`; sweeps' code {code}). "
+    lines += [f"Against the report of {p['date']} ({code}). "
               "Runs are matched by model, scope and inputs. A quantity has moved when it changed by "
               f"{100 * MOVED:g} % or more (deformations below {SMALL_CM:g} cm: by {MOVED_CM:g} cm or more, shown as the "
               f"absolute change). Of the {len(section['runs'])} runs the report's tables show in both (RSJ at mu 0, every RSF, THF and "

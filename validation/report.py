@@ -4,7 +4,7 @@ with figures and a JSON of the same numbers.
 
 Run (from the repository root, one Numba thread is enough)::
 
-    python benchmarks/validation_report.py --sweep colonsim_results/sweep_thesis \\
+    python -m validation.report --sweep colonsim_results/sweep_thesis \\
         --validation-sweep colonsim_results/sweep_validation --size full
 
 The main sweep is the ``thesis`` preset (the source's insertions with its meshed scope diameters),
@@ -14,7 +14,11 @@ the validation sweep the ``validation`` preset (mesh pair, half-speed rate check
 sizes of the CI tests and the calibration with the pipeline's quick budget; ``--size full`` at
 the full sizes of the tests and the default budget. The sweeps are only read: runs missing from a
 table are reported as missing, the claims that need them as NOT EVALUATED, and the sections of a
-validation sweep that has not run as NOT RUN.
+validation sweep that has not run as NOT RUN. ``--markdown-only`` writes ``OUT/report.md`` again
+from ``OUT/report.json`` (after a change of the page's layout), reading no sweep.
+
+The page names no commit and no folder outside the repository (``report.json`` keeps both; a test
+scans the site's pages for them).
 """
 
 from __future__ import annotations
@@ -32,7 +36,6 @@ from pathlib import Path
 
 import numpy as np
 
-ROOT = Path(__file__).resolve().parents[1]
 
 from colonsim.errors import ColonsimError
 from colonsim.files import write_json
@@ -42,27 +45,29 @@ from colonsim.insertion.study.sweep_presets import HALF_SPEED
 from colonsim.insertion.case.ringing import RINGING_LIMIT
 from colonsim.insertion.study.claims import evaluate_claims
 
-import validation_carry
-import validation_changes as changes
-import validation_checks as checks
-import validation_figures as figures
-import validation_sections as sections
-import validation_resistance as resistance
-import validation_smoothness as smoothness
-from validation_markdown import write_markdown
-from validation_readings import add_readings
-from validation_sweeps import paired, read_sweep
+from . import carry
+from . import changes
+from . import checks
+from . import figures
+from . import sections
+from . import resistance
+from . import smoothness
+from .markdown import write_markdown
+from .readings import add_readings
+from .sweeps import paired, read_sweep
 
 SYMBOL = {"rsf": "alpha", "thf": "beta"}
 
 
-def header(args, started, sweeps):
+def header(args, argv, started, sweeps):
+    """The report's provenance: the page shows it without commits or machine paths
+    (validation/markdown.py), report.json keeps it whole."""
     # taken when the script started (code_version caches it), before it rewrote its own outputs
     recorded = code_version()["git_commit"] or "unknown (not a git checkout)"
     commit, dirty = recorded.removesuffix("+modified"), recorded.endswith("+modified")
     threads = os.environ.get("NUMBA_NUM_THREADS")
-    command = ("NUMBA_NUM_THREADS=" + threads + " " if threads else "") + "python " + " ".join(
-        shlex.quote(a) for a in [os.path.relpath(sys.argv[0], ROOT) if os.path.isabs(sys.argv[0]) else sys.argv[0], *sys.argv[1:]])
+    command = ("NUMBA_NUM_THREADS=" + threads + " " if threads else "") + " ".join(
+        ["python -m validation.report", *(shlex.quote(a) for a in argv)])
     return {"date": started.isoformat(timespec="seconds"), "commit": commit,
             "commit_note": "uncommitted changes in tracked files" if dirty else "clean tree",
             "machine": f"{platform.system()} {platform.machine()}, {os.cpu_count()} cores, Python {platform.python_version()}",
@@ -188,6 +193,18 @@ def _clean(value):
     return value
 
 
+def rewrite_markdown(out) -> int:
+    """Write ``out/report.md`` again from ``out/report.json``; 2 when there is no report there."""
+    source = Path(out) / "report.json"
+    if not source.is_file():
+        print(f"error: no report.json in {out}; give the folder of a report with --out (default docs/validation)",
+              file=sys.stderr)
+        return 2
+    write_markdown(json.loads(source.read_text(encoding="utf-8")), Path(out) / "report.md")
+    print(f"wrote {Path(out) / 'report.md'} from {source}")
+    return 0
+
+
 def main(argv=None):
     code_version()  # the commit and whether the tree is clean, before anything is written
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
@@ -212,11 +229,16 @@ def main(argv=None):
                              "section on what moved since, which says NOT RUN without it")
     parser.add_argument("--carry", action="store_true",
                         help="take every section whose sweep is not given from --previous, marked with the report "
-                             "and code it comes from, instead of saying NOT RUN (benchmarks/validation_carry.py)")
+                             "and code it comes from, instead of saying NOT RUN (validation/carry.py)")
     parser.add_argument("--out", type=Path, default=Path("docs/validation"), help="output folder (default docs/validation)")
     parser.add_argument("--size", choices=("reduced", "full"), default="reduced",
                         help="verification at the CI test sizes and quick calibration budget, or at full size")
+    parser.add_argument("--markdown-only", action="store_true",
+                        help="rewrite OUT/report.md from OUT/report.json after a change of the page's layout: no "
+                             "sweep is read and nothing is recomputed")
     args = parser.parse_args(argv)
+    if args.markdown_only:
+        return rewrite_markdown(args.out)
     started = datetime.datetime.now(datetime.timezone.utc)
     t0 = time.perf_counter()
     try:
@@ -261,14 +283,14 @@ def main(argv=None):
                  "replicates": replicates}
     flexure_source = "section 10"
     if args.carry and args.validation_sweep is None:  # the claims' readings cite the flexure turns (section 10)
-        carried = validation_carry.carried_section(previous, "validation", ("flexure_sensitivity",))
+        carried = carry.carried_section(previous, "validation", ("flexure_sensitivity",))
         if carried is not None:
             sensitivity = carried
             flexure_source = f"section 10, carried from the report of {carried['carried_from']['date']}"
     claims = add_readings([c.to_dict() for c in evaluate_claims(main_sweep.table)], main_sweep, sensitivity["rows"],
                           flexure_source)
     times = sections.run_times(main_sweep)
-    doc = {"header": header(args, started, described), "verification": verification,
+    doc = {"header": header(args, sys.argv[1:] if argv is None else argv, started, described), "verification": verification,
            "calibration": calibration, "rsj": {"rows": rsj_rows, "checks": sections.rsj_checks(rsj_rows)},
            "claims": claims, "flexure_models": flexure_models(main_sweep, out),
            "ringing": {"limit": RINGING_LIMIT, "sweeps": {"main": sections.ringing_rows(main_sweep),
@@ -286,7 +308,7 @@ def main(argv=None):
                       "total_s": time.perf_counter() - t0}
     doc = _clean(doc)
     if args.carry:
-        doc["header"]["carried"] = validation_carry.carry(
+        doc["header"]["carried"] = carry.carry(
             doc, previous, {label: sweep.folder is not None for label, sweep in described.items()})
     doc["changes"] = changes.changes(previous, doc)  # both documents as JSON holds them (NaN -> null)
     write_json(out / "report.json", doc)

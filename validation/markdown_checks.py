@@ -6,7 +6,7 @@ from __future__ import annotations
 import math
 
 from colonsim.markdown import NOT_RUN, md_table, num, percent
-from validation_carry import carried_lines
+from .carry import carried_lines
 
 
 def verdict(passed):

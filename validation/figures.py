@@ -12,8 +12,8 @@ from colonsim.insertion.study.reference import SOURCE_RSJ_CM
 from colonsim.insertion.case.results import read_final_shape
 from colonsim.insertion.case.scenario import insertion_geometry
 
-from validation_sections import RSJ_DIAMETERS
-from validation_sweeps import SCOPES, role
+from .sections import RSJ_DIAMETERS
+from .sweeps import SCOPES, role
 
 COLOURS = {"utc": "tab:blue", "pdc": "tab:orange", "sdc": "tab:red", None: "tab:gray"}
 
