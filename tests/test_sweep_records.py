@@ -181,3 +181,22 @@ def test_colonsim_sweep_resumes_in_an_unpacked_record(tmp_path, capsys):
     capsys.readouterr()
     assert main(["sweep", str(toml), "--dry-run", "--out", str(tmp_path / "again")]) == 0
     assert f"10 runs, 3 already in {tmp_path / 'again'}/" in capsys.readouterr().out
+
+
+def test_a_table_only_record_keeps_the_table_and_summaries_and_a_sweep_resumes_in_it(tmp_path, capsys):
+    """``pack --table-only`` (the patient-space sweeps, which the predictor reads by their tables):
+    no series, no shapes; unpacked, the table and summaries are back and a resumed sweep counts
+    the runs done."""
+    _sweep(tmp_path / "sweep", [K["k1"], K["k2"]], failed=[K["k3"]])
+    assert records.main(["pack", "--table-only", str(tmp_path / "sweep"), str(tmp_path / "record")]) == 0
+    kept = sorted(p.name for p in (tmp_path / "record" / "runs" / K["k1"]).iterdir())
+    assert kept == ["summary.json"]
+    assert json.loads((tmp_path / "record" / "packed.json").read_text())[-1]["series"] is False
+    records.unpack(tmp_path / "record", tmp_path / "again")
+    pd.testing.assert_frame_equal(pd.read_parquet(tmp_path / "again" / "results.parquet").drop(columns="timeseries_path"),
+                                  pd.read_parquet(tmp_path / "sweep" / "results.parquet").drop(columns="timeseries_path"))
+    assert (tmp_path / "again" / "runs" / K["k2"] / "summary.json").is_file()
+    assert not (tmp_path / "again" / "runs" / K["k2"] / "timeseries.csv").exists()
+    # packed with its series, the same folder gives a record with them (the two modes are one option apart)
+    records.pack(tmp_path / "sweep", tmp_path / "full")
+    assert (tmp_path / "full" / "runs" / K["k1"] / "series.parquet").is_file()

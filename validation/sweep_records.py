@@ -22,6 +22,7 @@ for the 39), against 1.4 / 3.8 MB for an RSJ / RSF run folder.
 Use::
 
     python -m validation.sweep_records pack SWEEP_DIR RECORD_DIR     # add SWEEP_DIR's finished runs
+    python -m validation.sweep_records pack --table-only SWEEP_DIR RECORD_DIR   # their table and summaries only
     python -m validation.sweep_records unpack RECORD_DIR SWEEP_DIR   # a sweep folder again
     python -m validation.sweep_records status [RECORDS_DIR]          # what each record holds
 
@@ -152,13 +153,15 @@ def _merge(source, target, have, rows) -> int:
     return len(merged)
 
 
-def pack(sweep_dir, record_dir) -> dict:
+def pack(sweep_dir, record_dir, series=True) -> dict:
     """Add the finished runs of the sweep folder ``sweep_dir`` to the record ``record_dir``.
 
     A run is packed when its row says ok or failed; an ok run also needs its summary, time series
     and final shape in its run folder (else it is left out and named). A run the record holds
     already (the same key, finished at the same time) is left as it is, so that packing again
-    rewrites no file of it. Returns the counts."""
+    rewrites no file of it. ``series`` False keeps of each run its summary only (``--table-only``:
+    what a surrogate and a resumed sweep read, a few kB a run; the report's figures need the
+    series). Returns the counts."""
     sweep, record, table, kept = _folders(sweep_dir, record_dir, "the folder of a sweep (its --out)")
     held = {r["key"]: r.get("finished_at") for r in kept.to_dict("records")}
     rows, incomplete = [], []
@@ -170,22 +173,23 @@ def pack(sweep_dir, record_dir) -> dict:
                 continue
             run = sweep / Path(str(row["timeseries_path"])).parent if row.get("timeseries_path") else None
             if row["status"] == "ok":
-                files = [run / RUN_SUMMARY, run / RUN_SERIES, run / RUN_SHAPE] if run else []
+                files = ([run / RUN_SUMMARY] + ([run / RUN_SERIES, run / RUN_SHAPE] if series else [])) if run else []
                 if not files or not all(f.is_file() for f in files):
                     incomplete.append(key)
                     continue
                 target = stage / key
                 target.mkdir()
                 shutil.copyfile(files[0], target / RUN_SUMMARY)
-                series = pd.read_csv(files[1], usecols=list(SERIES_COLUMNS))
-                pack_series(series).to_parquet(target / SERIES, index=False, compression="zstd")
-                np.savez_compressed(target / SHAPE, **pack_shape(read_final_shape(run)))
+                if series:
+                    frame = pd.read_csv(files[1], usecols=list(SERIES_COLUMNS))
+                    pack_series(frame).to_parquet(target / SERIES, index=False, compression="zstd")
+                    np.savez_compressed(target / SHAPE, **pack_shape(read_final_shape(run)))
             rows.append(row)
     total = _merge(sweep, record, kept, rows)
     log = json.loads((record / LOG).read_text(encoding="utf-8")) if (record / LOG).is_file() else []
     log.append({"date": datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds"),
                 "packed_by": code_version().get("git_commit"), "from": str(sweep), "runs": len(rows),
-                "left_out": incomplete, "rows_after": total})
+                "left_out": incomplete, "rows_after": total, "series": bool(series)})
     write_json(record / LOG, log)
     return {"packed": len(rows), "incomplete": incomplete, "rows": total}
 
@@ -202,9 +206,10 @@ def unpack(record_dir, sweep_dir) -> dict:
                 target = stage / row["key"]
                 target.mkdir()
                 shutil.copyfile(source / RUN_SUMMARY, target / RUN_SUMMARY)
-                unpack_series(pd.read_parquet(source / SERIES)).to_csv(target / RUN_SERIES, index=False)
-                with np.load(source / SHAPE, allow_pickle=False) as data:
-                    np.savez_compressed(target / RUN_SHAPE, **unpack_shape({n: data[n] for n in data.files}))
+                if (source / SERIES).is_file():  # a run packed --table-only has its summary only
+                    unpack_series(pd.read_parquet(source / SERIES)).to_csv(target / RUN_SERIES, index=False)
+                    with np.load(source / SHAPE, allow_pickle=False) as data:
+                        np.savez_compressed(target / RUN_SHAPE, **unpack_shape({n: data[n] for n in data.files}))
                 row = {**row, "timeseries_path": f"runs/{row['key']}/{RUN_SERIES}"}
             rows.append(row)
     _merge(record, sweep, have, rows)
@@ -229,6 +234,9 @@ def main(argv=None) -> int:
     p = sub.add_parser("pack", help="add a sweep folder's finished runs to a record")
     p.add_argument("sweep")
     p.add_argument("record")
+    p.add_argument("--table-only", action="store_true",
+                   help="keep of each run its summary only, not its time series and final shape (what a surrogate "
+                        "and a resumed sweep read)")
     u = sub.add_parser("unpack", help="write a record as a sweep folder")
     u.add_argument("record")
     u.add_argument("sweep")
@@ -243,7 +251,7 @@ def main(argv=None) -> int:
                 print(f"{s['record']}: sweep {s['sweep']!r}, {s['ok']} ok + {s['failed']} failed of "
                       f"{s['defined'] or '?'} defined; rows' code {code}")
         elif args.command == "pack":
-            done = pack(args.sweep, args.record)
+            done = pack(args.sweep, args.record, series=not args.table_only)
             print(f"packed {done['packed']} runs into {args.record} ({done['rows']} in the record)"
                   + (f"; left out, their run folders incomplete: {', '.join(done['incomplete'])}"
                      if done["incomplete"] else ""))
