@@ -15,7 +15,11 @@ __version__ = "0.1.0"
 # module of a higher layer; the first use of ``colonsim.insert`` imports colonsim.api
 # (docs/architecture.md, "Layers").
 _API = ("calibrate", "insert", "sweep", "fit_surrogate", "predict", "recommend", "load_surrogate")
-__all__ = ["ColonsimError", *_API]
+# beside them, in modules of their own (colonsim.api_calibration, colonsim.api_insertion)
+_API_CALIBRATION = ("calibrate_strip", "calibrate_multimode", "export_cards")
+_API_INSERTION = ("simulate",)
+_API_MORE = _API_CALIBRATION + _API_INSERTION
+__all__ = ["ColonsimError", *_API, *_API_MORE]
 
 
 def __getattr__(name):
@@ -23,8 +27,12 @@ def __getattr__(name):
         from colonsim import api
 
         return getattr(api, name)
+    if name in _API_MORE:
+        from colonsim import api_calibration, api_insertion
+
+        return getattr(api_calibration if name in _API_CALIBRATION else api_insertion, name)
     raise AttributeError(f"module 'colonsim' has no attribute {name!r}")
 
 
 def __dir__():
-    return sorted(set(globals()) | set(_API))
+    return sorted(set(globals()) | set(_API) | set(_API_MORE))

@@ -29,6 +29,8 @@ class ModeRequest:
     analytic: bool = False
     mesh: tuple = (8, 3)
     quick: bool = False
+    budget: object = None  # a search Budget for every fit; None: quick's or the model's default
+    modes: tuple | None = None  # fit only the curves of these test modes; None: every curve
     seed: int = 1
     displacement_unit: str | None = None
     force_unit: str | None = None
@@ -60,7 +62,14 @@ def _curves(request: ModeRequest):
         return [read_stress_curve(request.curve, request.mode, stress_measure=request.stress_measure)]
     if request.mode is not None:
         raise ColonsimError("--mode goes with --curve; a mode manifest has its own mode column")
-    return read_mode_manifest(request.manifest, request.stress_measure, request.displacement_unit, request.force_unit)
+    curves = read_mode_manifest(request.manifest, request.stress_measure, request.displacement_unit, request.force_unit)
+    if request.modes is None:
+        return curves
+    chosen = [c for c in curves if c.mode in request.modes]
+    if not chosen:
+        raise ColonsimError(f"{request.manifest} has no curve in mode {', '.join(request.modes)}; "
+                            f"its modes: {', '.join(sorted({c.mode for c in curves}))}")
+    return chosen
 
 
 def _clean(curves, request, out):
@@ -143,7 +152,7 @@ def calibrate_modes(request: ModeRequest, out: Path) -> list:
         raise ColonsimError(f"--stability-range {lo:g} {hi:g}: it must run from below 1 to above 1 (e.g. 0.5 4)")
     curves = _clean(_curves(request), request, out)
     strip_model = "fe" if (not request.analytic and any(c.strip is not None for c in curves)) else "closed-form"
-    budget = (Budget.quick() if request.quick else Budget()) if strip_model == "fe" else None
+    budget = request.budget or ((Budget.quick() if request.quick else Budget()) if strip_model == "fe" else None)
     options = dict(residuals=request.residuals, budget=budget, seed=request.seed,
                    stability_range=request.stability_range, strip_model=strip_model, mesh=request.mesh)
     print(f"fitting {len(curves)} curve(s) jointly: " + ", ".join(f"{c.name} ({c.mode})" for c in curves), flush=True)

@@ -37,6 +37,10 @@ MAX_RUNS = 20_000
 # evaluation solves this mesh at every displacement point, 600 evaluations per fit; 8x3 is the
 # default, 32x12 already takes hours.
 MESH_MAX = (64, 24)
+# Evaluations of each stage of a search budget given through the Python API (designs, CMA-ES
+# population and evaluations, Nelder-Mead evaluations): the largest default is the closed-form
+# fits' 4,000; an evaluation of the 8x3 strip takes ~0.15 s, so 100,000 is already about 4 hours.
+BUDGET_MAX = 100_000
 # Simulated displacement points along a curve (default 20): each is a nonlinear solve per evaluation.
 POINTS_RANGE = (5, 200)
 # Specimen geometry in mm (free length, width, wall thickness): wide bounds that only keep the

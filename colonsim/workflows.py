@@ -47,6 +47,7 @@ class CalibrationRequest:
     mesh: tuple = (8, 3)
     points: int = 20
     quick: bool = False
+    budget: object = None  # an identification Budget; None: the full one, or quick's
     seed: int = 1
     workers: int = 2
     show_progress: bool = True
@@ -211,7 +212,7 @@ def calibrate(request: CalibrationRequest, out: Path) -> list:
         if value is not None:
             check_geometry_mm(quantity, value, request.given_as)
     curves = _clean(_load_curves(request), request, out)
-    budget = Budget.quick() if request.quick else Budget()
+    budget = request.budget or (Budget.quick() if request.quick else Budget())
     options = dict(law=law, analytic=request.analytic, budget=budget, seed=request.seed, n_points=request.points)
     if not request.analytic:
         options.update(n_length=request.mesh[0], n_width=request.mesh[1])
