@@ -14,16 +14,15 @@ import threading
 import warnings
 from pathlib import Path
 
-from colonsim import catalog, cli_material, cli_surrogate, cli_sweep, options
+from colonsim import catalog, options
 from colonsim.errors import ColonsimError, ColonsimWarning
 from colonsim.files import os_failure
-from colonsim.input_ranges import check_input_range
 from colonsim.limits import MESH_MAX, POINTS_RANGE
 from colonsim.options import bounded_int, finite_float, output_folder, positive_int, seed, worker_count
-from colonsim.insertion.case.insertion_case import TIME_STEP_ESTIMATES, InsertionCase
-from colonsim.insertion.engine.contact_points import WALL_SAMPLINGS
-from colonsim.insertion.case.run_budget import DEFAULT_MAX_STEPS
 
+# The modules below the command line are imported by the command that needs them, not here: the
+# insertion engine (Numba) takes a second or two to import, which `colonsim predict` never pays
+# (tests/test_cli.py checks that the predict path leaves it unimported).
 
 
 def _mesh(text):
@@ -40,6 +39,8 @@ def _mesh(text):
 
 
 def _add_calibrate(sub):
+    from colonsim import cli_material
+
     p = sub.add_parser("calibrate", help="identify hyperelastic parameters from tensile test curves",
                        description="Fit a hyperelastic law to strip tensile curves (docs/model.md): Latin-hypercube "
                                    "sensitivity study -> CMA-ES -> Nelder-Mead on a scikit-fem model of the "
@@ -81,6 +82,7 @@ def _add_calibrate(sub):
 
 
 def cmd_calibrate(args):
+    from colonsim import cli_material
     from colonsim.workflows import CalibrationRequest, calibrate
 
     if cli_material.wants_modes(args):
@@ -99,6 +101,8 @@ def cmd_calibrate(args):
 
 def cmd_demo(args):
     from colonsim.demo import DemoOptions, run_demo
+    from colonsim.input_ranges import check_input_range
+    from colonsim.insertion.case.insertion_case import InsertionCase
 
     check_input_range("element_size_mm", args.element_size, "--element-size: ")  # before the calibration runs
     # the case's own range checks, before the calibration runs
@@ -112,6 +116,10 @@ def cmd_demo(args):
 
 
 def _add_insert(sub):
+    from colonsim.insertion.case.insertion_case import TIME_STEP_ESTIMATES, InsertionCase
+    from colonsim.insertion.case.run_budget import DEFAULT_MAX_STEPS
+    from colonsim.insertion.engine.contact_points import WALL_SAMPLINGS
+
     p = sub.add_parser("insert", help="simulate a colonoscope insertion (explicit dynamics)",
                        description="Push a colonoscope through a colon model (docs/model.md) and record the colon "
                                    "deformation, contact and push forces, tip motion and energies. Writes "
@@ -226,17 +234,9 @@ class OneLineParser(argparse.ArgumentParser):
         raise ColonsimError(f"{message} (see '{self.prog} --help')")
 
 
-def build_parser():
-    from colonsim import __version__
+def _add_demo(sub):
+    from colonsim.insertion.case.insertion_case import InsertionCase
 
-    parser = OneLineParser(prog="colonsim", description="Colonoscope-colon interaction toolkit.")
-    parser.add_argument("--version", action="version", version=f"colonsim {__version__}")
-    sub = parser.add_subparsers(dest="command", required=True)
-    _add_calibrate(sub)
-    _add_insert(sub)
-    cli_material.add_parsers(sub)
-    cli_sweep.add_parser(sub)
-    cli_surrogate.add_parsers(sub)
     demo = sub.add_parser("demo", help="run the workflows on the bundled data (a few minutes on 2 cores)")
     demo.add_argument("--out", type=output_folder, default="colonsim_demo", help="output folder (default colonsim_demo)")
     demo.add_argument("--element-size", type=finite_float, default=InsertionCase.element_size_mm,
@@ -254,6 +254,48 @@ def build_parser():
     demo.add_argument("--target", choices=("max_deformation_cm", "final_deformation_cm"), default=catalog.PAIN_PROXY,
                       help="deformation the summary and the recommendations rank by (default: the largest over the run)")
     demo.set_defaults(func=cmd_demo)
+
+
+def _add_material(sub):
+    from colonsim import cli_material
+
+    cli_material.add_parsers(sub)
+
+
+def _add_sweep(sub):
+    from colonsim import cli_sweep
+
+    cli_sweep.add_parser(sub)
+
+
+def _add_surrogate(sub):
+    from colonsim import cli_surrogate
+
+    cli_surrogate.add_parsers(sub)
+
+
+# command -> the function that adds its parser (with the others it shares a module with)
+COMMANDS = {"calibrate": _add_calibrate, "insert": _add_insert, "material": _add_material, "sweep": _add_sweep,
+            "surrogate": _add_surrogate, "predict": _add_surrogate, "recommend": _add_surrogate, "demo": _add_demo}
+
+
+def command_of(argv):
+    """The command ``argv`` names (its first word that is no option), or None."""
+    return next((word for word in argv if not word.startswith("-")), None)
+
+
+def build_parser(command=None):
+    """The command line's parser: every command's (``command`` None, as for the site's reference
+    and ``colonsim --help``), or only ``command``'s, which imports only the modules it needs."""
+    from colonsim import __version__
+
+    parser = OneLineParser(prog="colonsim", description="Colonoscope-colon interaction toolkit.")
+    parser.add_argument("--version", action="version", version=f"colonsim {__version__}")
+    sub = parser.add_subparsers(dest="command", required=True)
+    adders = ([COMMANDS[command]] if command in COMMANDS else
+              list(dict.fromkeys(COMMANDS.values())))  # each module's adder once, in the order of COMMANDS
+    for add in adders:
+        add(sub)
     return parser
 
 
@@ -301,7 +343,8 @@ def main(argv=None):
         warnings.simplefilter("always", ColonsimWarning)
         warnings.showwarning = show_warning
         try:
-            args = build_parser().parse_args(argv)
+            argv = sys.argv[1:] if argv is None else list(argv)
+            args = build_parser(command_of(argv)).parse_args(argv)
             args.func(args)
         except ColonsimError as exc:
             print(f"colonsim: error: {_one_line(exc)}", file=sys.stderr)

@@ -191,12 +191,12 @@ def cmd_fit(args):
 
 
 def cmd_info(args):
-    from colonsim.surrogate.predictor import SHIPPED, load_shipped
+    from colonsim.surrogate.predictor import load_shipped, shipped_path
     from colonsim.surrogate.store import load_surrogate, model_paths
 
     model = load_shipped() if args.model is None else load_surrogate(args.model)
     if args.json:
-        print(model_paths(SHIPPED if args.model is None else args.model)[0].read_text(encoding="utf-8"), end="")
+        print(model_paths(shipped_path() if args.model is None else args.model)[0].read_text(encoding="utf-8"), end="")
         return
     about = getattr(model, "about_", None)
     if about:
@@ -244,7 +244,8 @@ def cmd_predict(args):
     from colonsim.surrogate.model import SUFFIXES
 
     model, strict, note = load_model(args)
-    frame = query_frame(args, model)
+    frame, defaults = query_frame(args, model)
+    note = (note + defaults).removeprefix("; ")
     _check_material(model, frame["segment"], strict)
     targets = list(args.target or model.targets)
     unknown = sorted(set(targets) - set(model.targets))
@@ -280,7 +281,8 @@ def cmd_recommend(args):
     model, strict, note = load_model(args)
     segment = _segment(args, model)
     _check_material(model, [segment], strict)
-    query = patient_query(model, segment, args, presets_of(args))
+    query, defaults = patient_query(model, segment, args, presets_of(args))
+    note = (note + defaults).removeprefix("; ")
     rec = recommend(model, segment, query, scopes=args.scope, target=args.target, reference=args.reference,
                     strict=strict)
     if note:
@@ -304,7 +306,7 @@ def cmd_plot(args):
     model, strict, _ = load_model(args)
     segment = _segment(args, model)
     vs = VS_NAMES.get(args.vs.lower(), args.vs)
-    query = patient_query(model, segment, args, presets_of(args))
+    query, _ = patient_query(model, segment, args, presets_of(args))
     fig = prediction_figure(model, segment, vs, query, target=args.target, scopes=args.scope, strict=strict)
     save_figure(fig, args.out)
     print(f"figure: {args.out}")
