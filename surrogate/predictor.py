@@ -36,6 +36,7 @@ from colonsim.insertion.case.case_material import case_material
 from colonsim.insertion.study.tissue_stiffness import MISMATCH_NOTE, shape_mismatch
 from colonsim.surrogate.recommend import default_scopes
 from colonsim.surrogate.store import load_surrogate, model_paths
+from colonsim.surrogate.table import INPUT_OPTIONS
 from colonsim.surrogate.tissue import TissueDistribution
 
 SHIPPED = data_path("predictor", "patient_space")  # .json + .npz
@@ -99,8 +100,8 @@ def defaults_note(defaults) -> str:
     """One phrase naming the defaults a query took ("" for none)."""
     if not defaults:
         return ""
-    return ("; " + ", ".join(f"{k} {v:g}" for k, v in defaults.items())
-            + " (colonsim insert's defaults; give --friction / --distal-resistance for the patient's)")
+    return ("; " + ", ".join(f"{k} {v:g}" for k, v in defaults.items()) + " (colonsim insert's defaults; give "
+            + " / ".join(INPUT_OPTIONS[k] for k in defaults) + " for the patient's)")
 
 
 def with_material(model, material):

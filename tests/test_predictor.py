@@ -145,6 +145,7 @@ def test_the_patient_space_presets_parse_into_cases():
 
 def test_without_a_shipped_model_the_call_says_so_and_how_to_fit_one(tmp_path, monkeypatch, capsys):
     monkeypatch.setattr(predictor, "SHIPPED", tmp_path / "patient_space")
+    monkeypatch.delenv(predictor.OVERRIDE, raising=False)
     with pytest.raises(ColonsimError, match="ships no fitted predictor.*colonsim surrogate fit"):
         load_shipped()
     assert main(["predict", "--segment", "rsf", "--angle", "45", "--scope", "9.2", "--diameter", "36"]) == 2
