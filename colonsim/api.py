@@ -207,13 +207,14 @@ def _query(model, segment, query):
 
 
 def _with_material(model, segment, material, strict):
+    """``model`` with the tissue of ``material`` (None: as it is), and why that material lies
+    outside its domain ("" inside; refused with ``strict``)."""
     if material is None:
-        return model
+        return model, ""
     from colonsim.surrogate.predictor import check_material, with_material
 
     model, _ = with_material(model, material)
-    check_material(model, segment, strict=strict)
-    return model
+    return model, check_material(model, segment, strict=strict)
 
 
 def predict(model=None, segment=None, *, targets=None, strict=None, material=None, **inputs):
@@ -259,8 +260,10 @@ def predict(model=None, segment=None, *, targets=None, strict=None, material=Non
         raise ColonsimError("give each input one value or as many as the others (one query per row)")
     frame = pd.DataFrame({k: v * rows if len(v) == 1 else v for k, v in columns.items()}, index=range(rows))
     frame = frame.assign(**_query(model, segment, frame))
-    model = _with_material(model, segment, material, strict)
-    return model.predict_frame(frame, targets=targets, segment=segment, strict=strict)
+    from colonsim.surrogate.predictor import mark_extrapolated
+
+    model, outside = _with_material(model, segment, material, strict)
+    return mark_extrapolated(model.predict_frame(frame, targets=targets, segment=segment, strict=strict), outside)
 
 
 def recommend(model=None, segment=None, *, sex=None, age=None, region=None, scopes=None, target=PAIN_PROXY,
@@ -286,5 +289,7 @@ def recommend(model=None, segment=None, *, sex=None, age=None, region=None, scop
     strict = shipped if strict is None else strict
     query = {**patient_inputs(segment, sex, age, region), **inputs}
     query.update(_query(model, segment, query))
-    model = _with_material(model, segment, material, strict)
-    return rank(model, segment, query, scopes=scopes, target=target, strict=strict)
+    from colonsim.surrogate.predictor import mark_extrapolated
+
+    model, outside = _with_material(model, segment, material, strict)
+    return mark_extrapolated(rank(model, segment, query, scopes=scopes, target=target, strict=strict), outside)

@@ -121,22 +121,44 @@ def with_material(model, material):
     return model, note
 
 
-def check_material(model, segment, strict=True):
+def check_material(model, segment, strict=True) -> str:
     """Refuse (``strict``) a model whose tissue distribution's mean stiffness lies outside the
-    segment's training range, naming the material and by how much; returns that mean (or None
-    when the segment's model does not take the stiffness)."""
+    segment's training range, naming the material and by how much; else return that phrase for
+    the answers to mark (:func:`mark_extrapolated`), "" when the mean is inside or the segment's
+    model does not take the stiffness."""
     domain = model.domains_.get(str(segment).lower())
     if domain is None or TISSUE_STIFFNESS not in domain.inputs or model.tissue_ is None:
-        return None
+        return ""
     mean = float(np.mean(model.tissue_.draws()[TISSUE_STIFFNESS]))
     j = domain.inputs.index(TISSUE_STIFFNESS)
     low, high = float(domain.low[j]), float(domain.high[j])
-    if strict and not low <= mean <= high:
-        by, side = (low - mean, "below") if mean < low else (mean - high, "above")
-        raise ColonsimError(f"{model.tissue_.description}: tissue stiffness {mean:.3g} outside {low:g}-{high:g} of the "
-                            f"{domain.segment} runs ({by:.3g} {side}); the predictor does not extrapolate unless asked "
-                            "(--extrapolate)")
-    return mean
+    if low <= mean <= high:
+        return ""
+    by, side = (low - mean, "below") if mean < low else (mean - high, "above")
+    outside = (f"{model.tissue_.description}: tissue stiffness {mean:.3g} outside {low:g}-{high:g} of the "
+               f"{domain.segment} runs ({by:.3g} {side})")
+    if strict:
+        raise ColonsimError(f"{outside}; the predictor does not extrapolate unless asked (--extrapolate)")
+    return outside
+
+
+def mark_extrapolated(answer, outside: str, segment=None):
+    """Mark as outside the training domain, for the reason ``outside`` (from :func:`check_material`;
+    "" marks nothing), the rows of ``segment`` of a prediction frame (every row: None) or every
+    scope of a recommendation (a dict), so that each of their printed numbers says so."""
+    if not outside:
+        return answer
+    if isinstance(answer, dict):
+        answer["in_domain"] = False
+        for s in answer["scopes"]:
+            s["in_domain"] = False
+            s["domain_note"] = "; ".join(filter(None, (s["domain_note"], outside)))
+        return answer
+    rows = answer.index if segment is None else answer.index[answer["segment"] == str(segment).lower()]
+    answer.loc[rows, "in_domain"] = False
+    answer.loc[rows, "domain_note"] = ["; ".join(filter(None, (note, outside)))
+                                       for note in answer.loc[rows, "domain_note"]]
+    return answer
 
 
 def predict_deformation(segment, scope=None, *, scope_diameter_mm=None, angle_deg=None, diameter_mm=None,
@@ -172,10 +194,10 @@ def predict_deformation(segment, scope=None, *, scope_diameter_mm=None, angle_de
     model = load_shipped() if model is None else model
     if material is not None and tissue_stiffness is not None:
         raise ColonsimError("give the tissue as a stiffness factor or as a material file, not both")
-    note = ""
+    note, outside = "", ""
     if material is not None:
         model, note = with_material(model, material)
-        check_material(model, segment, strict=not extrapolate)
+        outside = check_material(model, segment, strict=not extrapolate)
     values = {"scope_diameter_mm": scope_diameter_mm, "angle_deg": angle_deg, "diameter_mm": diameter_mm,
               "friction": friction, "distal_resistance_N": distal_resistance_N, TISSUE_STIFFNESS: tissue_stiffness}
     base = {"segment": str(segment).lower(), **{k: v for k, v in values.items() if v is not None}}
@@ -189,4 +211,4 @@ def predict_deformation(segment, scope=None, *, scope_diameter_mm=None, angle_de
     out = model.predict_frame(frame, targets=list(targets), strict=not extrapolate)
     if note:
         out["tissue_note"] = out["tissue_note"] + "; " + note.removeprefix("; ")
-    return out
+    return mark_extrapolated(out, outside)

@@ -247,6 +247,19 @@ def test_the_cli_uses_the_shipped_model_and_marks_every_extrapolated_number(ship
     assert main(["predict", *patient, "--scope", "9.2", "--material",
                  str(material_file(tmp_path / "m.json", 3.0))]) == 2
     assert "tissue stiffness 3 outside" in capsys.readouterr().err
+    # a material inside: its stiffness and spread, nothing marked; outside with --extrapolate: every number marked
+    assert main(["predict", *patient, "--scope", "9.2", "--material", str(material_file(tmp_path / "i.json", 1.2))]) == 0
+    out = capsys.readouterr().out
+    assert "i.json maps to tissue stiffness 1.2 (sd 0.0" in out and "[EXTRAPOLATED]" not in out
+    stiff = str(material_file(tmp_path / "m.json", 3.0))
+    assert main(["predict", *patient, "--scope", "9.2", "--material", stiff, "--extrapolate"]) == 0
+    lines = [line for line in capsys.readouterr().out.splitlines() if "(95 %:" in line]
+    assert len(lines) == 2 and all("[EXTRAPOLATED]" in line for line in lines)
+    assert main(["recommend", *patient, "--material", stiff, "--extrapolate"]) == 0
+    text = capsys.readouterr().out
+    assert text.startswith("[EXTRAPOLATED] RSF") and all("[EXTRAPOLATED]" in line for line in text.splitlines()
+                                                        if " mm): " in line or "sd, cm" in line)
+    assert "tissue stiffness 3 outside" in text
 
 
 # -- the held-out table ----------------------------------------------------------------------------------
