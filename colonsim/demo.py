@@ -119,7 +119,7 @@ def run_demo(options: DemoOptions) -> dict:
     seconds["live insertion"] = time.perf_counter() - t
     t = time.perf_counter()
     predicted = predictor_step(material, live, options.target, section)
-    if predicted is None:
+    if "no_predictions" in predicted:
         section.done += 1  # the comparison's section: nothing to compare with
     else:
         write_json(out / "predictions.json", predicted)

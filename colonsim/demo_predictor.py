@@ -14,6 +14,8 @@ PATIENTS = (
     {"label": "young African patient", "age": "young", "region": "african"},
     {"label": "older European patient (diverticular disease)", "age": "older", "region": "european"},
 )
+NO_PREDICTOR = ("this colonsim ships no fitted predictor yet (its patient-space sweeps have not been run); "
+                "'colonsim demo --sweep' fits a surrogate on a small sweep of its own instead")
 # the outputs the live run is set beside the predictor's answer for
 COMPARED = ("max_deformation_cm", "final_deformation_cm")
 # run settings the predictor's runs hold fixed: a live run at others is not the case they answer
@@ -88,19 +90,18 @@ def patient_recommendations(model, segment: str, target: str, strict: bool = Fal
     return recs
 
 
-def predictor_step(material, live, target: str, section) -> dict | None:
+def predictor_step(material, live, target: str, section) -> dict:
     """Ask the shipped predictor (or the model ``COLONSIM_PREDICTOR`` names) about the calibrated
     ``material``: each scope for the two :data:`PATIENTS`, ranked by ``target``, and the case of
     the ``live`` run (an :class:`InsertionResult`) at the material's stiffness factor. Returns
-    what it answered, or None (said in one line) when no predictor ships or it cannot answer for
-    this material."""
+    what it answered, or ``{"no_predictions": why}`` (printed, one line) when no predictor ships
+    or it does not answer for this material and these patients."""
     from colonsim.surrogate.predictor import check_material, load_shipped, predict_deformation, shipped_exists, with_material
 
     section("the predictor shipped with colonsim: the calibrated material's patients, the scopes ranked")
     if not shipped_exists():
-        print("no predictions: this colonsim ships no fitted predictor yet (its patient-space sweeps have not been "
-              "run); 'colonsim demo --sweep' fits a surrogate on a small sweep of its own instead")
-        return None
+        print(f"no predictions: {NO_PREDICTOR}")
+        return {"no_predictions": NO_PREDICTOR}
     model = load_shipped()
     case = live.case
     try:
@@ -114,7 +115,7 @@ def predictor_step(material, live, target: str, section) -> dict | None:
                                    targets=COMPARED, model=model).iloc[0]
     except ColonsimError as exc:
         print(f"no predictions for this material: {exc}")
-        return None
+        return {"no_predictions": f"the predictor does not answer for this material and these patients: {exc}"}
     section(f"the live run beside the predictor's answer for the same case ({case.segment.upper()} "
             f"{case.scope.upper()}, D = {case.diameter_mm:g} mm, mu = {case.friction:g}, distal resistance "
             f"{case.distal_resistance_N:g} N, tissue stiffness {factor:.3g})")

@@ -7,10 +7,6 @@ from pathlib import Path
 
 from colonsim.catalog import PAIN_PROXY
 
-NO_PREDICTOR = ("No predictions: this colonsim ships no fitted predictor yet (its patient-space sweeps have not "
-                "been run). `colonsim demo --sweep` fits a surrogate on a small sweep of its own instead.")
-
-
 def _cell(v) -> str:
     return f"{v:.3g}" if isinstance(v, float) else str(v)
 
@@ -46,8 +42,9 @@ def _predictor_section(predicted) -> list:
     from colonsim.surrogate.recommend import format_recommendation
 
     lines = ["## 3. The shipped predictor (`predictions.json`)", ""]
-    if predicted is None:
-        return lines + [NO_PREDICTOR, "", "## 4. The live run beside the predictor", "", "Nothing to compare with.", ""]
+    if "no_predictions" in predicted:
+        return lines + [f"No predictions: {predicted['no_predictions']}.", "",
+                        "## 4. The live run beside the predictor", "", "Nothing to compare with.", ""]
     lines += [f"Fitted on {', '.join(predicted['sweeps']) or 'unnamed sweeps'} by the engine of "
               f"{', '.join(c[:10] for c in predicted['engine_commits']) or 'unknown commits'}. Tissue: "
               f"{predicted['tissue_note']}.", ""]
@@ -119,15 +116,16 @@ def print_summary(calibration, live, predicted, target=PAIN_PROXY, swept=None):
 
     print("\n== summary", flush=True)
     mu0 = get_law(calibration.model["law"]).initial_shear_modulus(calibration.parameters)
-    factor = "" if predicted is None else f"; tissue stiffness factor {predicted['stiffness_factor']:.3g}"
+    answered = "no_predictions" not in predicted
+    factor = f"; tissue stiffness factor {predicted['stiffness_factor']:.3g}" if answered else ""
     print(f"calibration: small-strain shear modulus mu0 = {mu0 / 1e3:.1f} kPa "
           f"({', '.join(f'{n} {v / 1e3:.1f} kPa' for n, v in calibration.parameter_dict.items())}){factor}")
     what = "largest colon deformation over the run" if target == PAIN_PROXY else target
     case = live.case
     print(f"live run, {case.segment.upper()} {case.scope.upper()} D = {case.diameter_mm:g} mm, mu = {case.friction:g}: "
           f"{what} {live.summary[target]:.2f} cm")
-    if predicted is None:
-        print("predictor: none shipped yet, no predictions")
+    if not answered:
+        print(f"predictor: no predictions ({predicted['no_predictions']})")
     else:
         print(f"predictor, {what}, the calibrated material:")
         for rec in predicted["recommendations"]:

@@ -17,8 +17,8 @@ import pytest
 
 from colonsim.catalog import SMOKE_ELEMENT_MM, SMOKE_PUSH_SPEED, SMOKE_SCOPE_SPACING_MM
 from colonsim.demo import DemoOptions, Sections, run_demo
-from colonsim.demo_predictor import comparison, comparison_line, predictor_step
-from colonsim.demo_report import NO_PREDICTOR, write_report
+from colonsim.demo_predictor import NO_PREDICTOR, comparison, comparison_line, predictor_step
+from colonsim.demo_report import write_report
 from colonsim.demo_sweep import REPLICATE_MESH
 from colonsim.insertion.case.insertion_case import InsertionCase
 from colonsim.surrogate import predictor
@@ -67,7 +67,7 @@ def test_demo_runs_every_workflow_and_writes_one_folder(tmp_path, capsys, monkey
     recs = json.loads((out / "surrogate_recommendations.json").read_text())
     assert [r["patient"]["region"] for r in recs] == ["african", "european"]
     summary = text.split("== summary")[1]
-    assert "predictor: none shipped yet, no predictions" in summary and "rests on 12 runs" in summary
+    assert f"predictor: no predictions ({NO_PREDICTOR})" in summary and "rests on 12 runs" in summary
     for rec in recs:
         assert rec["target"] == "max_deformation_cm" and rec["n_runs"] == 12
         # a number where the model vouches for its error, else the reason instead of one
@@ -76,7 +76,7 @@ def test_demo_runs_every_workflow_and_writes_one_folder(tmp_path, capsys, monkey
         means = [s["mean"] for s in rec["scopes"]]
         assert means == sorted(means)  # the ranking is by predicted deformation
     report = (out / "report.md").read_text()
-    assert NO_PREDICTOR in report and "## 7. Its recommendations" in report
+    assert f"No predictions: {NO_PREDICTOR}." in report and "## 7. Its recommendations" in report
     assert (f"{SMOKE_ELEMENT_MM:g} mm wall mesh with scope nodes every {SMOKE_SCOPE_SPACING_MM:g} mm, pushed at "
             f"{SMOKE_PUSH_SPEED:g} m/s") in report
     assert set(table["push_speed"]) == set(replicates["push_speed"]) == {SMOKE_PUSH_SPEED}
@@ -124,7 +124,8 @@ def test_the_live_value_is_said_inside_or_outside_the_interval_both_ways():
 def test_without_a_predictor_the_demo_says_so_in_one_line_and_predicts_nothing(tmp_path, capsys, monkeypatch):
     monkeypatch.setattr(predictor, "SHIPPED", tmp_path / "none")
     monkeypatch.delenv(predictor.OVERRIDE, raising=False)
-    assert predictor_step(tmp_path / "material.json", None, "max_deformation_cm", Sections(4)) is None
+    assert predictor_step(tmp_path / "material.json", None, "max_deformation_cm", Sections(4)) == \
+        {"no_predictions": NO_PREDICTOR}
     lines = capsys.readouterr().out.strip().splitlines()
     assert lines[0] == "== 1/4 the predictor shipped with colonsim: the calibrated material's patients, the scopes ranked"
     assert len(lines) == 2 and lines[1].startswith("no predictions: this colonsim ships no fitted predictor yet")
@@ -140,6 +141,7 @@ def test_a_material_outside_the_predictors_domain_gets_no_predictions_and_one_li
     (tmp_path / "stiff.json").write_text(json.dumps(doc))
     monkeypatch.setenv(predictor.OVERRIDE, str(tiny_rsj_predictor(tmp_path)))
     live = SimpleNamespace(case=InsertionCase(), summary={})  # the refusal comes before any live number is read
-    assert predictor_step(tmp_path / "stiff.json", live, "max_deformation_cm", Sections(4)) is None
+    why = predictor_step(tmp_path / "stiff.json", live, "max_deformation_cm", Sections(4))["no_predictions"]
+    assert "does not answer for this material" in why and "tissue stiffness 3 outside" in why
     out = capsys.readouterr().out
     assert "no predictions for this material:" in out and "tissue stiffness 3 outside" in out
