@@ -46,9 +46,10 @@ def test_demo_runs_every_workflow_and_writes_one_folder(tmp_path, capsys, monkey
     made = run_demo(DemoOptions(out=out, element_size_mm=SMOKE_ELEMENT_MM, scope_spacing_mm=SMOKE_SCOPE_SPACING_MM,
                                 push_speed=SMOKE_PUSH_SPEED, sweep=True, show_progress=False))
     text = capsys.readouterr().out
-    for step in range(1, 8):
+    for step in (1, 2, 3, 5, 6, 7):
         assert f"== {step}/7 " in text
-    assert "== 4/7" not in text.split("== 3/7")[0] and text.count("no predictions: this colonsim ships no fitted") == 1
+    # no predictor: one line, and no comparison with the live run (its section is not printed)
+    assert "== 4/7" not in text and text.count("no predictions: this colonsim ships no fitted") == 1
     material = json.loads((out / "calibration" / "material.json").read_text())
     assert material["parameters"]["C11"] > 0
     run = json.loads((out / "insertion" / "rsj_SDC" / "summary.json").read_text())
