@@ -16,6 +16,9 @@ function                 what it does                                  command l
 :func:`recommend`        rank the scopes for a patient                 ``colonsim recommend``
 =======================  ============================================  ============================
 
+:func:`predict` and :func:`recommend` ask the predictor shipped with colonsim when no model is
+given (docs/surrogate.md, "The predictor shipped with colonsim").
+
 The examples run as tests (``tests/test_api.py``) at the smoke size of
 :mod:`colonsim.catalog`: coarse meshes and a fast push, whose numbers are not results.
 """
