@@ -17,6 +17,7 @@ import pandas as pd
 
 from colonsim.catalog import TISSUE_STIFFNESS
 from colonsim.insertion.study.sweep_presets import PATIENT_MODELS as DESIGNS, PATIENT_RANGES
+from colonsim.insertion.study.sweep_spec import LHS_DECIMALS
 from colonsim.surrogate.model import TIP_FOLDED, SweepSurrogate
 from colonsim.surrogate.predictor import SHIPPED
 from colonsim.surrogate.store import save_surrogate
@@ -66,11 +67,12 @@ def design_domains(model):
     """Widen each segment's domain (in place) from the runs' box to the sweep's design ranges.
 
     A Latin hypercube of n runs puts one run in each of the n strata of every range, so the runs'
-    box falls short of the design range by less than one stratum (range / n) at either end: a
-    query at the edge of the design (friction 0, the default of an insertion) is then at most that
-    far from a run, where the GP interpolates as it does between runs. Where the runs fall short of
-    an end by more than one stratum (a sweep not of this design, or runs lost), the domain keeps
-    the runs' bound. The GP's input scaling is its own and is not changed."""
+    box falls short of the design range by less than one stratum (range / n) at either end, plus
+    the rounding of its values to :data:`LHS_DECIMALS`: a query at the edge of the design
+    (friction 0, the default of an insertion) is then at most that far from a run, where the GP
+    interpolates as it does between runs. Where the runs fall short of an end by more (a sweep not
+    of this design, or its end run lost: failed or tip-folded), the domain keeps the runs' bound.
+    The GP's input scaling is its own and is not changed."""
     for segment, domain in model.domains_.items():
         low, high = domain.low.copy(), domain.high.copy()
         for j, name in enumerate(domain.inputs):
@@ -78,7 +80,7 @@ def design_domains(model):
             if design is None:
                 continue
             lo, hi, runs = design
-            stratum = (hi - lo) / runs
+            stratum = (hi - lo) / runs + 0.5 * 10.0 ** -LHS_DECIMALS
             if lo <= low[j] <= lo + stratum:
                 low[j] = lo
             if hi - stratum <= high[j] <= hi:
