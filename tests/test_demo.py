@@ -1,6 +1,6 @@
 """``colonsim demo`` end to end on a coarse wall mesh: every step runs and writes what the README promises.
 
-The full demo uses the 3 mm mesh (under three minutes on 2 cores); the smoke size (a 5 mm wall mesh,
+The full demo uses the 3 mm mesh (a few minutes on 2 cores); the smoke size (a 5 mm wall mesh,
 scope nodes every 10 mm, pushed at 0.6 m/s: colonsim.catalog) keeps this check near four minutes
 on a slow machine, ``--sweep`` included. Its numbers are not physics (too coarse, too fast), so
 only their consistency is checked. The predictor it asks is a tiny one fitted on a SYNTHETIC table
