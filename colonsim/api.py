@@ -16,6 +16,9 @@ function                 what it does                                  command l
 :func:`recommend`        rank the scopes for a patient                 ``colonsim recommend``
 =======================  ============================================  ============================
 
+:func:`predict` and :func:`recommend` ask the predictor shipped with colonsim when no model is
+given (docs/surrogate.md, "The predictor shipped with colonsim").
+
 The examples run as tests (``tests/test_api.py``) at the smoke size of
 :mod:`colonsim.catalog`: coarse meshes and a fast push, whose numbers are not results.
 """
@@ -187,18 +190,62 @@ def load_surrogate(path):
 
 
 def _model(model):
+    """The model asked: a fitted surrogate, the path of its JSON file, or None for the predictor
+    shipped with colonsim (:func:`colonsim.surrogate.predictor.load_shipped`)."""
+    if model is None:
+        from colonsim.surrogate.predictor import load_shipped
+
+        return load_shipped()
     return load_surrogate(model) if isinstance(model, (str, Path)) else model
 
 
-def predict(model, segment, *, targets=None, strict=False, **inputs):
+def _query(model, segment, query):
+    """``query`` (a mapping or a frame) with a predictor's defaults for the inputs it leaves out
+    (friction, distal resistance: colonsim insert's), and the tissue of ``material`` if given."""
+    from colonsim.surrogate.predictor import query_defaults
+
+    if segment is None:
+        raise ColonsimError("give the colon model: segment='rsj', 'rsf', 'thf', ...")
+    return query_defaults(model, segment, query)
+
+
+def _with_material(model, segment, material, strict):
+    """``model`` with the tissue of ``material`` (None: as it is), and why that material lies
+    outside its domain ("" inside; refused with ``strict``)."""
+    if material is None:
+        return model, ""
+    from colonsim.surrogate.predictor import check_material, with_material
+
+    model, _ = with_material(model, material)
+    return model, check_material(model, segment, strict=strict)
+
+
+def predict(model=None, segment=None, *, targets=None, strict=None, material=None, **inputs):
     """Predict outputs at the given inputs: one row per combination of scopes given.
 
-    ``model`` is a fitted surrogate or the path of its JSON file; ``inputs`` are the model's inputs
-    (``scope`` or ``scope_diameter_mm``, ``diameter_mm``, ``angle_deg``, ``friction``, ...; a list
-    for several queries). Each target gets its mean, sd and 95 % interval, NaN where the model has
-    too few runs to know its error (``error_note`` says so); ``in_domain`` flags extrapolation.
+    ``model`` is a fitted surrogate, the path of its JSON file, or None: the predictor shipped
+    with colonsim, over the patient space of RSJ, RSF and THF, whose friction and distal
+    resistance default to ``colonsim insert``'s (0 and 5 N). ``inputs`` are the model's inputs
+    (``scope`` or ``scope_diameter_mm``, ``diameter_mm``, ``angle_deg``, ``friction``,
+    ``distal_resistance_N``, ``tissue_stiffness``, ...; a list for several queries);
+    ``material``, a calibrated ``material.json``, gives the tissue (its stiffness factor, its
+    parameter uncertainty in the interval). Each target gets its mean, sd and 95 % interval, NaN
+    where the model has too few runs to know its error (``error_note`` says so); ``in_domain``
+    flags extrapolation. ``strict``: refuse a query outside the training domain (default: yes for
+    the shipped predictor, no for a model of your own, which warns).
+
+    The shipped predictor, for an RSF patient with a 45 degree alpha angle and a 36 mm colon:
 
     >>> import colonsim
+    >>> frame = colonsim.predict(segment="rsf", scope="pdc", angle_deg=45, diameter_mm=36)
+    >>> frame[["scope", "friction", "distal_resistance_N"]].values.tolist()
+    [['pdc', 0.0, 5.0]]
+    >>> row = frame.iloc[0]
+    >>> bool(row["max_deformation_cm_low95"] < row["max_deformation_cm"] < row["max_deformation_cm_high95"])
+    True
+
+    A model fitted on a sweep of your own (:func:`fit_surrogate`):
+
     >>> frame = colonsim.predict("model.json", "rsj", scope=["utc", "sdc"], diameter_mm=30, friction=0.05)
     >>> list(frame["scope"]), bool(frame["in_domain"].all())
     (['utc', 'sdc'], True)
@@ -208,22 +255,30 @@ def predict(model, segment, *, targets=None, strict=False, **inputs):
     import numpy as np
     import pandas as pd
 
-    model = _model(model)
+    shipped, model = model is None, _model(model)
+    strict = shipped if strict is None else strict
     columns = {k: (list(v) if isinstance(v, (list, tuple, np.ndarray)) else [v]) for k, v in inputs.items()}
     rows = max((len(v) for v in columns.values()), default=1)
     if any(len(v) not in (1, rows) for v in columns.values()):
         raise ColonsimError("give each input one value or as many as the others (one query per row)")
-    frame = pd.DataFrame({k: v * rows if len(v) == 1 else v for k, v in columns.items()})
-    return model.predict_frame(frame, targets=targets, segment=segment, strict=strict)
+    frame = pd.DataFrame({k: v * rows if len(v) == 1 else v for k, v in columns.items()}, index=range(rows))
+    frame = frame.assign(**_query(model, segment, frame))
+    from colonsim.surrogate.predictor import mark_extrapolated
+
+    model, outside = _with_material(model, segment, material, strict)
+    return mark_extrapolated(model.predict_frame(frame, targets=targets, segment=segment, strict=strict), outside)
 
 
-def recommend(model, segment, *, sex=None, age=None, region=None, scopes=None, target=PAIN_PROXY, **inputs) -> dict:
+def recommend(model=None, segment=None, *, sex=None, age=None, region=None, scopes=None, target=PAIN_PROXY,
+              strict=None, material=None, **inputs) -> dict:
     """Rank the scopes for a patient by the predicted ``target`` (the largest deformation by default).
 
-    The patient is given by presets (``sex`` -> angle, ``age`` -> friction, ``region`` -> colon
-    diameter; docs/surrogate.md) and/or raw inputs, which win over the presets. Returns per scope the
-    mean, sd and 95 % interval and, where the model can vouch for its error, the probability that
-    it deforms the colon least and less than the standard scope (None where it cannot).
+    ``model``, ``material`` and ``strict`` as in :func:`predict` (None: the predictor shipped with
+    colonsim). The patient is given by presets (``sex`` -> angle, ``age`` -> friction, ``region``
+    -> colon diameter; docs/surrogate.md) and/or raw inputs, which win over the presets. Returns
+    per scope the mean, sd and 95 % interval and, where the model can vouch for its error, the
+    probability that it deforms the colon least and less than the standard scope (None where it
+    cannot).
 
     >>> import colonsim
     >>> ranking = colonsim.recommend("model.json", "rsj", age="older", region="european")
@@ -233,5 +288,11 @@ def recommend(model, segment, *, sex=None, age=None, region=None, scopes=None, t
     from colonsim.surrogate.patients import patient_inputs
     from colonsim.surrogate.recommend import recommend as rank
 
+    shipped, model = model is None, _model(model)
+    strict = shipped if strict is None else strict
     query = {**patient_inputs(segment, sex, age, region), **inputs}
-    return rank(_model(model), segment, query, scopes=scopes, target=target)
+    query.update(_query(model, segment, query))
+    from colonsim.surrogate.predictor import mark_extrapolated
+
+    model, outside = _with_material(model, segment, material, strict)
+    return mark_extrapolated(rank(model, segment, query, scopes=scopes, target=target, strict=strict), outside)

@@ -14,16 +14,15 @@ import threading
 import warnings
 from pathlib import Path
 
-from colonsim import catalog, cli_material, cli_surrogate, cli_sweep, options
+from colonsim import catalog, options
 from colonsim.errors import ColonsimError, ColonsimWarning
 from colonsim.files import os_failure
-from colonsim.input_ranges import check_input_range
 from colonsim.limits import MESH_MAX, POINTS_RANGE
 from colonsim.options import bounded_int, finite_float, output_folder, positive_int, seed, worker_count
-from colonsim.insertion.case.insertion_case import TIME_STEP_ESTIMATES, InsertionCase
-from colonsim.insertion.engine.contact_points import WALL_SAMPLINGS
-from colonsim.insertion.case.run_budget import DEFAULT_MAX_STEPS
 
+# The modules below the command line are imported by the command that needs them, not here: the
+# insertion engine (Numba) takes a second or two to import, which `colonsim predict` never pays
+# (tests/test_cli.py checks that the predict path leaves it unimported).
 
 
 def _mesh(text):
@@ -40,6 +39,8 @@ def _mesh(text):
 
 
 def _add_calibrate(sub):
+    from colonsim import cli_material
+
     p = sub.add_parser("calibrate", help="identify hyperelastic parameters from tensile test curves",
                        description="Fit a hyperelastic law to strip tensile curves (docs/model.md): Latin-hypercube "
                                    "sensitivity study -> CMA-ES -> Nelder-Mead on a scikit-fem model of the "
@@ -81,6 +82,7 @@ def _add_calibrate(sub):
 
 
 def cmd_calibrate(args):
+    from colonsim import cli_material
     from colonsim.workflows import CalibrationRequest, calibrate
 
     if cli_material.wants_modes(args):
@@ -99,6 +101,8 @@ def cmd_calibrate(args):
 
 def cmd_demo(args):
     from colonsim.demo import DemoOptions, run_demo
+    from colonsim.input_ranges import check_input_range
+    from colonsim.insertion.case.insertion_case import InsertionCase
 
     check_input_range("element_size_mm", args.element_size, "--element-size: ")  # before the calibration runs
     # the case's own range checks, before the calibration runs
@@ -107,11 +111,15 @@ def cmd_demo(args):
             InsertionCase(**{field: value}).validate()
 
     run_demo(DemoOptions(out=args.out, element_size_mm=args.element_size, scope_spacing_mm=args.scope_spacing,
-                         push_speed=args.push_speed, workers=args.workers, show_progress=not args.no_progress,
-                         target=args.target))
+                         push_speed=args.push_speed, sweep=args.sweep, workers=args.workers,
+                         show_progress=not args.no_progress, target=args.target))
 
 
 def _add_insert(sub):
+    from colonsim.insertion.case.insertion_case import TIME_STEP_ESTIMATES, InsertionCase
+    from colonsim.insertion.case.run_budget import DEFAULT_MAX_STEPS
+    from colonsim.insertion.engine.contact_points import WALL_SAMPLINGS
+
     p = sub.add_parser("insert", help="simulate a colonoscope insertion (explicit dynamics)",
                        description="Push a colonoscope through a colon model (docs/model.md) and record the colon "
                                    "deformation, contact and push forces, tip motion and energies. Writes "
@@ -226,34 +234,75 @@ class OneLineParser(argparse.ArgumentParser):
         raise ColonsimError(f"{message} (see '{self.prog} --help')")
 
 
-def build_parser():
+def _add_demo(sub):
+    from colonsim.insertion.case.insertion_case import InsertionCase
+
+    demo = sub.add_parser("demo", help="run the workflows on the bundled data (a few minutes on 2 cores)",
+                          description="Calibrate on the bundled synthetic tensile data (reduced budget), run one "
+                                      "insertion with the calibrated material, ask the predictor shipped with colonsim "
+                                      "about that material for two patients and rank the scopes, and set the live run "
+                                      "beside the predictor's answer for the same case. Writes report.md.")
+    demo.add_argument("--out", type=output_folder, default="colonsim_demo", help="output folder (default colonsim_demo)")
+    demo.add_argument("--sweep", action="store_true",
+                      help="also run a 12-run sweep of the demo's own (RSJ x 3 scopes x 2 diameters x 2 frictions, "
+                           "4 replicates) and fit a surrogate on it: some minutes more")
+    demo.add_argument("--element-size", type=finite_float, default=InsertionCase.element_size_mm,
+                      help=f"wall mesh of the insertion and the sweep, mm (default {InsertionCase.element_size_mm:g}; "
+                           "coarser is faster, not validated)")
+    demo.add_argument("--scope-spacing", type=finite_float, default=None,
+                      help=f"scope node spacing of the insertion and the sweep, mm (default "
+                           f"{InsertionCase.scope_spacing_mm:g}; coarser is faster, not validated)")
+    demo.add_argument("--push-speed", type=finite_float, default=None,
+                      help=f"push speed of the insertion and the sweep, m/s (default {InsertionCase.push_speed:g}, "
+                           "quasi-static; faster is cheaper and rings, not validated)")
+    demo.add_argument("--workers", type=worker_count, default=None,
+                      help="processes for the demo's sweep with --sweep (default: up to 2 cores)")
+    demo.add_argument("--no-progress", action="store_true", help="no progress bar")
+    demo.add_argument("--target", choices=("max_deformation_cm", "final_deformation_cm"), default=catalog.PAIN_PROXY,
+                      help="deformation the summary and the rankings go by (default: the largest over the run)")
+    demo.set_defaults(func=cmd_demo)
+
+
+def _add_material(sub):
+    from colonsim import cli_material
+
+    cli_material.add_parsers(sub)
+
+
+def _add_sweep(sub):
+    from colonsim import cli_sweep
+
+    cli_sweep.add_parser(sub)
+
+
+def _add_surrogate(sub):
+    from colonsim import cli_surrogate
+
+    cli_surrogate.add_parsers(sub)
+
+
+# command -> the function that adds its parser (with the others it shares a module with)
+COMMANDS = {"calibrate": _add_calibrate, "insert": _add_insert, "material": _add_material, "sweep": _add_sweep,
+            "surrogate": _add_surrogate, "predict": _add_surrogate, "recommend": _add_surrogate, "demo": _add_demo}
+
+
+def command_of(argv):
+    """The command ``argv`` names (its first word that is no option), or None."""
+    return next((word for word in argv if not word.startswith("-")), None)
+
+
+def build_parser(command=None):
+    """The command line's parser: every command's (``command`` None, as for the site's reference
+    and ``colonsim --help``), or only ``command``'s, which imports only the modules it needs."""
     from colonsim import __version__
 
     parser = OneLineParser(prog="colonsim", description="Colonoscope-colon interaction toolkit.")
     parser.add_argument("--version", action="version", version=f"colonsim {__version__}")
     sub = parser.add_subparsers(dest="command", required=True)
-    _add_calibrate(sub)
-    _add_insert(sub)
-    cli_material.add_parsers(sub)
-    cli_sweep.add_parser(sub)
-    cli_surrogate.add_parsers(sub)
-    demo = sub.add_parser("demo", help="run the workflows on the bundled data (a few minutes on 2 cores)")
-    demo.add_argument("--out", type=output_folder, default="colonsim_demo", help="output folder (default colonsim_demo)")
-    demo.add_argument("--element-size", type=finite_float, default=InsertionCase.element_size_mm,
-                      help=f"wall mesh of the insertions and the sweep, mm (default {InsertionCase.element_size_mm:g}; "
-                           "coarser is faster, not validated)")
-    demo.add_argument("--scope-spacing", type=finite_float, default=None,
-                      help=f"scope node spacing of the insertions and the sweep, mm (default "
-                           f"{InsertionCase.scope_spacing_mm:g}; coarser is faster, not validated)")
-    demo.add_argument("--push-speed", type=finite_float, default=None,
-                      help=f"push speed of the insertions and the sweep, m/s (default {InsertionCase.push_speed:g}, "
-                           "quasi-static; faster is cheaper and rings, not validated)")
-    demo.add_argument("--workers", type=worker_count, default=None,
-                      help="processes for the demo's sweep (default: up to 2 cores)")
-    demo.add_argument("--no-progress", action="store_true", help="no progress bar")
-    demo.add_argument("--target", choices=("max_deformation_cm", "final_deformation_cm"), default=catalog.PAIN_PROXY,
-                      help="deformation the summary and the recommendations rank by (default: the largest over the run)")
-    demo.set_defaults(func=cmd_demo)
+    adders = ([COMMANDS[command]] if command in COMMANDS else
+              list(dict.fromkeys(COMMANDS.values())))  # each module's adder once, in the order of COMMANDS
+    for add in adders:
+        add(sub)
     return parser
 
 
@@ -301,7 +350,8 @@ def main(argv=None):
         warnings.simplefilter("always", ColonsimWarning)
         warnings.showwarning = show_warning
         try:
-            args = build_parser().parse_args(argv)
+            argv = sys.argv[1:] if argv is None else list(argv)
+            args = build_parser(command_of(argv)).parse_args(argv)
             args.func(args)
         except ColonsimError as exc:
             print(f"colonsim: error: {_one_line(exc)}", file=sys.stderr)

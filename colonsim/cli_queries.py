@@ -51,18 +51,24 @@ def segment_of(args, model):
 
 
 def patient_query(model, segment, args, presets):
-    """Model inputs from presets, then raw options on top."""
+    """Model inputs from presets, then raw options on top, then a predictor's defaults for what
+    both leave out; and the phrase naming those defaults ("" for none)."""
     from colonsim.surrogate.patients import patient_inputs
+    from colonsim.surrogate.predictor import defaults_note, query_defaults
 
-    return {**patient_inputs(segment, args.sex, args.age, args.region, presets), **raw_inputs(args)}
+    query = {**patient_inputs(segment, args.sex, args.age, args.region, presets), **raw_inputs(args)}
+    defaults = query_defaults(model, segment, query)
+    return {**query, **defaults}, defaults_note(defaults)
 
 
 def query_frame(args, model):
-    """One row per query: from --csv (options fill its missing columns) or from the options, one per scope."""
+    """One row per query: from --csv (options fill its missing columns) or from the options, one per
+    scope; and the phrase naming the defaults a predictor's query took ("" for none)."""
     import numpy as np
     import pandas as pd
 
     from colonsim.surrogate.patients import patient_inputs
+    from colonsim.surrogate.predictor import query_defaults
     from colonsim.surrogate.recommend import default_scopes
     from colonsim.surrogate.table import read_query_file
 
@@ -85,18 +91,20 @@ def query_frame(args, model):
         for i, row in frame.iterrows():  # presets per row, where the row leaves the input empty
             p = patient_inputs(row["segment"], *(row.get(k) if isinstance(row.get(k), str) else getattr(args, k)
                                                   for k in ("sex", "age", "region")), presets=presets)
+            p.update(query_defaults(model, row["segment"], {**p, **{k: v for k, v in row.items() if pd.notna(v)}}))
             for col, value in p.items():
                 if col not in frame or pd.isna(frame.at[i, col]):
                     frame.loc[i, col] = value
-        return frame.drop(columns=[c for c in ("sex", "age", "region") if c in frame])
+        return frame.drop(columns=[c for c in ("sex", "age", "region") if c in frame]), ""
     segment = segment_of(args, model)
-    base = {"segment": segment, **patient_query(model, segment, args, presets)}
+    query, note = patient_query(model, segment, args, presets)
+    base = {"segment": segment, **query}
     scopes = args.scope
     if not scopes and "scope_diameter_mm" not in base and segment in model.domains_:
         domain = model.domains_[segment]
         scopes = default_scopes(domain) if "scope_diameter_mm" in domain.inputs else None
     rows = [{**base, "scope": s} for s in scopes] if scopes else [base]
-    return pd.DataFrame(rows).replace({np.nan: None})
+    return pd.DataFrame(rows).replace({np.nan: None}), note
 
 
 def records(frame):

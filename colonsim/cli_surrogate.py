@@ -191,12 +191,12 @@ def cmd_fit(args):
 
 
 def cmd_info(args):
-    from colonsim.surrogate.predictor import SHIPPED, load_shipped
+    from colonsim.surrogate.predictor import load_shipped, shipped_path
     from colonsim.surrogate.store import load_surrogate, model_paths
 
     model = load_shipped() if args.model is None else load_surrogate(args.model)
     if args.json:
-        print(model_paths(SHIPPED if args.model is None else args.model)[0].read_text(encoding="utf-8"), end="")
+        print(model_paths(shipped_path() if args.model is None else args.model)[0].read_text(encoding="utf-8"), end="")
         return
     about = getattr(model, "about_", None)
     if about:
@@ -232,25 +232,29 @@ def cmd_validate(args):
             print(f"written: {path}")
 
 
-def _check_material(model, segments, strict):
+def _check_material(model, segments, strict) -> dict:
+    """Segment -> why the material is outside its domain ("" inside); refused with ``strict``."""
     from colonsim.surrogate.predictor import check_material
 
-    for segment in dict.fromkeys(segments):
-        check_material(model, segment, strict=strict)
+    return {segment: check_material(model, segment, strict=strict) for segment in dict.fromkeys(segments)}
 
 
 def cmd_predict(args):
     from colonsim.files import write_csv, write_json
+    from colonsim.surrogate.predictor import mark_extrapolated
     from colonsim.surrogate.model import SUFFIXES
 
     model, strict, note = load_model(args)
-    frame = query_frame(args, model)
-    _check_material(model, frame["segment"], strict)
+    frame, defaults = query_frame(args, model)
+    note = (note + defaults).removeprefix("; ")
+    outside = _check_material(model, frame["segment"], strict)
     targets = list(args.target or model.targets)
     unknown = sorted(set(targets) - set(model.targets))
     if unknown:
         raise ColonsimError(f"the surrogate has no target {', '.join(unknown)}; it models {', '.join(model.targets)}")
     out = model.predict_frame(frame, targets=targets, strict=strict)
+    for segment, why in outside.items():
+        mark_extrapolated(out, why, segment)
     if note:
         out["tissue_note"] = out["tissue_note"] + "; " + note
     out = out.drop(columns=[t + suffix for t in targets if out[t].isna().all() for suffix in SUFFIXES])
@@ -275,14 +279,16 @@ def cmd_predict(args):
 def cmd_recommend(args):
     from colonsim.files import write_json
     from colonsim.surrogate.patients import describe_patient
+    from colonsim.surrogate.predictor import mark_extrapolated
     from colonsim.surrogate.recommend import format_recommendation, recommend
 
     model, strict, note = load_model(args)
     segment = _segment(args, model)
-    _check_material(model, [segment], strict)
-    query = patient_query(model, segment, args, presets_of(args))
-    rec = recommend(model, segment, query, scopes=args.scope, target=args.target, reference=args.reference,
-                    strict=strict)
+    outside = _check_material(model, [segment], strict)[segment]
+    query, defaults = patient_query(model, segment, args, presets_of(args))
+    note = (note + defaults).removeprefix("; ")
+    rec = mark_extrapolated(recommend(model, segment, query, scopes=args.scope, target=args.target,
+                                      reference=args.reference, strict=strict), outside)
     if note:
         rec["tissue"]["note"] += "; " + note
     patient = describe_patient(segment, args.sex, args.age, args.region, presets_of(args))
@@ -304,7 +310,7 @@ def cmd_plot(args):
     model, strict, _ = load_model(args)
     segment = _segment(args, model)
     vs = VS_NAMES.get(args.vs.lower(), args.vs)
-    query = patient_query(model, segment, args, presets_of(args))
+    query, _ = patient_query(model, segment, args, presets_of(args))
     fig = prediction_figure(model, segment, vs, query, target=args.target, scopes=args.scope, strict=strict)
     save_figure(fig, args.out)
     print(f"figure: {args.out}")

@@ -23,7 +23,6 @@ from __future__ import annotations
 
 import numpy as np
 from scipy.linalg import cho_solve, cholesky, solve_triangular
-from scipy.optimize import minimize
 
 from colonsim.errors import ColonsimError
 from colonsim.surrogate.hyperposterior import DRAWS, Mixture, laplace_draws
@@ -153,6 +152,8 @@ class GaussianProcess:
     def _maximize(self, value_and_gradient, bounds, starts):
         """The best of L-BFGS-B runs from each start within ``bounds`` of ``value_and_gradient(theta)
         -> (value, gradient)``; sets ``log_marginal_likelihood_`` to that value, returns its theta."""
+        from scipy.optimize import minimize  # on fitting only: a query does not pay its import
+
         def objective(theta):
             value, grad = value_and_gradient(theta)
             return (1e25, np.zeros_like(theta)) if not np.isfinite(value) else (-value, -grad)

@@ -33,9 +33,8 @@ derived.
 
 from __future__ import annotations
 
-import math
+import sys
 
-import numba
 import numpy as np
 
 from colonsim.surrogate.kernel import matern52
@@ -49,8 +48,9 @@ QUERY_CHUNK = 2048  # query rows predicted at once (memory: draws x rows x runs)
 # a batch this large runs its small matrix products on one BLAS thread: threads contending with
 # simulations for the cores made 10,000 queries of a 40-run model 6x slower (1.7 s against 0.28 s)
 ONE_THREAD_ROWS = 256
-# up to this many query rows the moments come from one compiled loop (:func:`few_rows_moments`):
-# numpy's thirty-odd calls on arrays of a few hundred numbers cost a single query 5-8x as long
+# up to this many query rows the moments come from one compiled loop
+# (:func:`colonsim.surrogate.gp_loops.few_rows_moments`) once Numba is loaded: numpy's thirty-odd
+# calls on arrays of a few hundred numbers cost a single query 5-8x as long
 FEW_ROWS = 32
 
 
@@ -77,65 +77,20 @@ def laplace_draws(theta, bounds, X, y, n_draws=DRAWS, floor=CURVATURE_FLOOR, see
     return np.clip(draws, low, high)
 
 
-@numba.njit(cache=True)
-def covariance_to_runs(Q, X, inv_length, constant, out):
-    """Each draw's Matern 5/2 covariance between the rows of ``Q`` (m, d) and the runs ``X`` (n, d)
-    into ``out`` (draws, m, n): inverse length scales ``inv_length[k]``, signal variance
-    ``constant[k]``, the formulas of :func:`few_rows_moments`. One pass over the output: numpy's
-    distance and correlation took ten temporaries of its size and three quarters of a batch's time
-    (2026-11-29, 10,000 queries of a 40-run model)."""
-    for k in range(out.shape[0]):
-        for i in range(Q.shape[0]):
-            for j in range(X.shape[0]):
-                out[k, i, j] = _covariance_of_rows(Q, i, X, j, inv_length, constant, k)
+def loaded_loops():
+    """The compiled loops (:mod:`colonsim.surrogate.gp_loops`) if Numba is loaded in this process,
+    else None.
 
+    A process that asks a few rows once (``colonsim predict``) answers them with numpy: importing
+    Numba and loading the cached loops costs it about half a second, to save a fraction of a
+    millisecond. Once Numba is loaded (a batch, a fit, a sweep, the solver), a few rows take the
+    compiled loop, which pays when a caller asks one row at a time, many times. The two give the
+    same numbers to round-off."""
+    if "numba" not in sys.modules:
+        return None
+    from colonsim.surrogate import gp_loops
 
-@numba.njit(cache=True, inline="always")
-def _covariance_of_rows(Q, i, X, j, inv_length, constant, k):
-    """Draw ``k``'s Matern 5/2 covariance between row ``i`` of ``Q`` and run ``j`` of ``X`` (the
-    distance from the difference of the rows)."""
-    r2 = 0.0
-    for a in range(X.shape[1]):
-        z = (Q[i, a] - X[j, a]) * inv_length[k, a]
-        r2 += z * z
-    s = math.sqrt(5.0 * r2)
-    return constant[k] * (1.0 + s + s * s / 3.0) * math.exp(-s)
-
-
-@numba.njit(cache=True)
-def few_rows_moments(Q, X, inv_length, constant, alpha, L_inv, noise, with_var, mean, var):
-    """The mixture's mean and the variance of a new result (standardized) at the rows of ``Q``
-    (m, d), into ``mean`` and ``var`` (m,): per draw k the Matern 5/2 covariance to the runs ``X``
-    (n, d) with inverse length scales ``inv_length[k]`` and signal variance ``constant[k]``, its
-    mean ``k . alpha[k]`` and variance ``constant[k] - |L_inv[k] k|^2 + noise[k]``; then the law
-    of total variance over the draws, as :meth:`Mixture._predict_rows` (the same numbers to
-    round-off: sums in another order, the distance from the difference of the rows)."""
-    draws, n = alpha.shape
-    cov = np.empty(n)
-    means = np.empty(draws)
-    variances = np.empty(draws)
-    for m in range(Q.shape[0]):
-        for k in range(draws):
-            mu = 0.0
-            for j in range(n):
-                cov[j] = _covariance_of_rows(Q, m, X, j, inv_length, constant, k)
-                mu += cov[j] * alpha[k, j]
-            means[k] = mu
-            if with_var:
-                explained = 0.0
-                for i in range(n):
-                    v = 0.0
-                    for j in range(n):
-                        v += L_inv[k, i, j] * cov[j]
-                    explained += v * v
-                variances[k] = max(constant[k] - explained + noise[k], 0.0)
-        centre = means.sum() / draws
-        mean[m] = centre
-        if with_var:
-            spread = 0.0
-            for k in range(draws):
-                spread += (means[k] - centre) ** 2
-            var[m] = variances.sum() / draws + spread / draws
+    return gp_loops
 
 
 class Mixture:
@@ -162,8 +117,13 @@ class Mixture:
         """Each draw's prior covariance between the rows of ``QA`` and ``QB``: (draws, m, n)."""
         return self.constant[:, None, None] * matern52(QA, QB, self.length_scale[:, None, :])
 
-    def _covariance_to_runs(self, Q):
-        """Each draw's prior covariance between the rows of ``Q`` and the runs: (draws, m, n)."""
+    def _covariance_to_runs(self, Q, compiled=True):
+        """Each draw's prior covariance between the rows of ``Q`` and the runs: (draws, m, n), by
+        the compiled loop (``compiled``, which imports Numba) or by numpy."""
+        if not compiled:
+            return self._covariance(Q, self.X)
+        from colonsim.surrogate.gp_loops import covariance_to_runs
+
         out = np.empty((len(self.constant), len(Q), len(self.X)))
         covariance_to_runs(np.ascontiguousarray(Q, dtype=float), self.X, self._inv_length, self.constant, out)
         return out
@@ -180,8 +140,11 @@ class Mixture:
             spread = means - means.mean(axis=0)
             return means.mean(axis=0), covs.mean(axis=0) + spread.T @ spread / len(means)
         if len(Q) <= FEW_ROWS:
+            loops = loaded_loops()
+            if loops is None:
+                return self._predict_rows(Q, return_var, compiled=False)
             mean, var = np.empty(len(Q)), np.empty(len(Q))
-            few_rows_moments(np.ascontiguousarray(Q, dtype=float), self.X, self._inv_length, self.constant,
+            loops.few_rows_moments(np.ascontiguousarray(Q, dtype=float), self.X, self._inv_length, self.constant,
                              self.alpha, self.L_inv, self.noise, return_var, mean, var)
             return (mean, var) if return_var else mean
         if len(Q) >= ONE_THREAD_ROWS:
@@ -191,11 +154,11 @@ class Mixture:
                 return self._predict_rows(Q, return_var)
         return self._predict_rows(Q, return_var)
 
-    def _predict_rows(self, Q, return_var):
+    def _predict_rows(self, Q, return_var, compiled=True):
         mean, var = np.empty(len(Q)), np.empty(len(Q))
         for start in range(0, len(Q), QUERY_CHUNK):
             rows = slice(start, start + QUERY_CHUNK)
-            k = self._covariance_to_runs(Q[rows])
+            k = self._covariance_to_runs(Q[rows], compiled)
             means = np.einsum("kmn,kn->km", k, self.alpha)
             # the moments over the draws as ndarray.mean / .var compute them, without their
             # Python-level wrappers (a third of a single query's time)

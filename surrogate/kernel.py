@@ -2,8 +2,8 @@
 
 The same function as scikit-learn's ``Matern(length_scale=[...], nu=2.5)``, written out so that a
 saved surrogate predicts with numpy alone (no scikit-learn, no pickle; a query takes compiled
-loops of the same formulas, ``hyperposterior.few_rows_moments`` for a few rows and
-``hyperposterior.covariance_to_runs`` for a batch's covariances) and a single
+loops of the same formulas, ``gp_loops.few_rows_moments`` for a few rows and
+``gp_loops.covariance_to_runs`` for a batch's covariances) and a single
 query is 2.4-9x faster than ``GaussianProcessRegressor.predict`` on the same model: 0.06 ms against
 0.49 ms (40 runs), 0.19 ms against 0.45 ms (500 runs); a batch of 10,000 queries takes about as
 long either way (0.8-1.6x). Measured by ``NUMBA_NUM_THREADS=1 python benchmarks/bench_surrogate.py``.

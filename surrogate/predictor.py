@@ -8,6 +8,10 @@ extrapolate. A calibrated ``material.json`` enters as the tissue stiffness facto
 (:mod:`colonsim.insertion.study.tissue_stiffness`), its parameter uncertainty as the tissue part
 of the interval (:mod:`colonsim.surrogate.tissue`).
 
+The environment variable ``COLONSIM_PREDICTOR`` (a model path) puts another model in the shipped
+one's place for every caller (``colonsim predict``, ``recommend``, ``demo``, the Python API): a
+predictor fitted with ``benchmarks/fit_predictor.py --out`` before it is committed, for example.
+
 Example (the shipped model; a model fitted on any patient-space table answers the same way)::
 
     from colonsim.surrogate.predictor import predict_deformation
@@ -19,6 +23,7 @@ Example (the shipped model; a model fitted on any patient-space table answers th
 from __future__ import annotations
 
 import copy
+import os
 from pathlib import Path
 
 import numpy as np
@@ -31,9 +36,16 @@ from colonsim.insertion.case.case_material import case_material
 from colonsim.insertion.study.tissue_stiffness import MISMATCH_NOTE, shape_mismatch
 from colonsim.surrogate.recommend import default_scopes
 from colonsim.surrogate.store import load_surrogate, model_paths
+from colonsim.surrogate.table import INPUT_OPTIONS
 from colonsim.surrogate.tissue import TissueDistribution
 
 SHIPPED = data_path("predictor", "patient_space")  # .json + .npz
+# a model path (without suffix, or its .json) answering in place of the shipped one: a predictor
+# fitted by benchmarks/fit_predictor.py --out before it is committed, or a test's
+OVERRIDE = "COLONSIM_PREDICTOR"
+# a predictor's query that leaves these inputs out takes colonsim insert's defaults (the insertion
+# case's, which tests/test_predictor.py checks these are), and says so
+QUERY_DEFAULTS = {"friction": 0.0, "distal_resistance_N": 5.0}
 # the outputs the predictor answers by default: the pain proxy and the final deformation
 DEFORMATIONS = ("max_deformation_cm", "final_deformation_cm")
 NO_SHIPPED = ("this colonsim ships no fitted predictor yet (its patient-space sweeps have not been run); give a model "
@@ -41,9 +53,18 @@ NO_SHIPPED = ("this colonsim ships no fitted predictor yet (its patient-space sw
               "PS/results.parquet -o MODEL'")
 
 
+def shipped_path(path=None) -> Path:
+    """Where the predictor is read: ``path``, else the environment variable ``COLONSIM_PREDICTOR``
+    (:data:`OVERRIDE`; a model path, ``.json`` or none), else the package data (:data:`SHIPPED`)."""
+    if path is not None:
+        return Path(path)
+    given = os.environ.get(OVERRIDE, "").strip()
+    return Path(given).with_suffix("") if given.endswith(".json") else Path(given) if given else SHIPPED
+
+
 def shipped_exists(path=None) -> bool:
-    """Whether this colonsim holds a shipped predictor (both of its files; ``path`` None: :data:`SHIPPED`)."""
-    return all(p.is_file() for p in model_paths(SHIPPED if path is None else path))
+    """Whether this colonsim holds a shipped predictor (both of its files, where :func:`shipped_path` says)."""
+    return all(p.is_file() for p in model_paths(shipped_path(path)))
 
 
 def load_shipped(path=None):
@@ -55,9 +76,32 @@ def load_shipped(path=None):
     ColonsimError
         None is shipped (one line saying how to fit one), or its files fail the load checks.
     """
-    if not shipped_exists(path):
+    where = shipped_path(path)
+    if not shipped_exists(where):
+        if path is None and where != SHIPPED:
+            raise ColonsimError(f"{OVERRIDE}={os.environ[OVERRIDE]}: no model there ({where}.json and .npz, written "
+                                "by 'colonsim surrogate fit' or benchmarks/fit_predictor.py); unset it to use the "
+                                "predictor shipped with colonsim")
         raise ColonsimError(NO_SHIPPED)
-    return load_surrogate(SHIPPED if path is None else path)
+    return load_surrogate(where)
+
+
+def query_defaults(model, segment, query) -> dict:
+    """The inputs of :data:`QUERY_DEFAULTS` that ``segment``'s model takes and ``query`` (a mapping,
+    or a frame's columns) leaves out, with their default; none for a model that is no predictor
+    (no ``about_``), whose user names every input."""
+    domain = model.domains_.get(str(segment).lower())
+    if getattr(model, "about_", None) is None or domain is None:
+        return {}
+    return {k: v for k, v in QUERY_DEFAULTS.items() if k in domain.inputs and query.get(k) is None}
+
+
+def defaults_note(defaults) -> str:
+    """One phrase naming the defaults a query took ("" for none)."""
+    if not defaults:
+        return ""
+    return ("; " + ", ".join(f"{k} {v:g}" for k, v in defaults.items()) + " (colonsim insert's defaults; give "
+            + " / ".join(INPUT_OPTIONS[k] for k in defaults) + " for the patient's)")
 
 
 def with_material(model, material):
@@ -77,22 +121,44 @@ def with_material(model, material):
     return model, note
 
 
-def check_material(model, segment, strict=True):
+def check_material(model, segment, strict=True) -> str:
     """Refuse (``strict``) a model whose tissue distribution's mean stiffness lies outside the
-    segment's training range, naming the material and by how much; returns that mean (or None
-    when the segment's model does not take the stiffness)."""
+    segment's training range, naming the material and by how much; else return that phrase for
+    the answers to mark (:func:`mark_extrapolated`), "" when the mean is inside or the segment's
+    model does not take the stiffness."""
     domain = model.domains_.get(str(segment).lower())
     if domain is None or TISSUE_STIFFNESS not in domain.inputs or model.tissue_ is None:
-        return None
+        return ""
     mean = float(np.mean(model.tissue_.draws()[TISSUE_STIFFNESS]))
     j = domain.inputs.index(TISSUE_STIFFNESS)
     low, high = float(domain.low[j]), float(domain.high[j])
-    if strict and not low <= mean <= high:
-        by, side = (low - mean, "below") if mean < low else (mean - high, "above")
-        raise ColonsimError(f"{model.tissue_.description}: tissue stiffness {mean:.3g} outside {low:g}-{high:g} of the "
-                            f"{domain.segment} runs ({by:.3g} {side}); the predictor does not extrapolate unless asked "
-                            "(--extrapolate)")
-    return mean
+    if low <= mean <= high:
+        return ""
+    by, side = (low - mean, "below") if mean < low else (mean - high, "above")
+    outside = (f"{model.tissue_.description}: tissue stiffness {mean:.3g} outside {low:g}-{high:g} of the "
+               f"{domain.segment} runs ({by:.3g} {side})")
+    if strict:
+        raise ColonsimError(f"{outside}; the predictor does not extrapolate unless asked (--extrapolate)")
+    return outside
+
+
+def mark_extrapolated(answer, outside: str, segment=None):
+    """Mark as outside the training domain, for the reason ``outside`` (from :func:`check_material`;
+    "" marks nothing), the rows of ``segment`` of a prediction frame (every row: None) or every
+    scope of a recommendation (a dict), so that each of their printed numbers says so."""
+    if not outside:
+        return answer
+    if isinstance(answer, dict):
+        answer["in_domain"] = False
+        for s in answer["scopes"]:
+            s["in_domain"] = False
+            s["domain_note"] = "; ".join(filter(None, (s["domain_note"], outside)))
+        return answer
+    rows = answer.index if segment is None else answer.index[answer["segment"] == str(segment).lower()]
+    answer.loc[rows, "in_domain"] = False
+    answer.loc[rows, "domain_note"] = ["; ".join(filter(None, (note, outside)))
+                                       for note in answer.loc[rows, "domain_note"]]
+    return answer
 
 
 def predict_deformation(segment, scope=None, *, scope_diameter_mm=None, angle_deg=None, diameter_mm=None,
@@ -108,7 +174,8 @@ def predict_deformation(segment, scope=None, *, scope_diameter_mm=None, angle_de
         Named scopes or diameters in mm (None: the scopes the sweep ran); or ``scope_diameter_mm``.
     angle_deg, diameter_mm, friction, distal_resistance_N : float or None
         The patient (alpha of RSF, beta of THF; colon diameter in mm; Coulomb friction; the force
-        in N that the colon beyond the model opposes to the tip).
+        in N that the colon beyond the model opposes to the tip). Friction and distal resistance
+        left out take colonsim insert's defaults (:data:`QUERY_DEFAULTS`), said in ``tissue_note``.
     tissue_stiffness : float or None
         The wall as a factor on the reference law; or ``material``, a calibrated ``material.json``
         mapped to it (its parameter uncertainty in the interval). Neither: the model's own tissue.
@@ -127,18 +194,21 @@ def predict_deformation(segment, scope=None, *, scope_diameter_mm=None, angle_de
     model = load_shipped() if model is None else model
     if material is not None and tissue_stiffness is not None:
         raise ColonsimError("give the tissue as a stiffness factor or as a material file, not both")
-    note = ""
+    note, outside = "", ""
     if material is not None:
         model, note = with_material(model, material)
-        check_material(model, segment, strict=not extrapolate)
+        outside = check_material(model, segment, strict=not extrapolate)
     values = {"scope_diameter_mm": scope_diameter_mm, "angle_deg": angle_deg, "diameter_mm": diameter_mm,
               "friction": friction, "distal_resistance_N": distal_resistance_N, TISSUE_STIFFNESS: tissue_stiffness}
     base = {"segment": str(segment).lower(), **{k: v for k, v in values.items() if v is not None}}
+    defaults = query_defaults(model, segment, base)
+    base.update(defaults)
+    note += defaults_note(defaults)
     scopes = [scope] if isinstance(scope, (str, int, float)) else scope
     if scopes is None and scope_diameter_mm is None and base["segment"] in model.domains_:
         scopes = default_scopes(model.domains_[base["segment"]])
     frame = pd.DataFrame([{**base, "scope": str(s)} for s in scopes] if scopes else [base])
     out = model.predict_frame(frame, targets=list(targets), strict=not extrapolate)
     if note:
-        out["tissue_note"] = out["tissue_note"] + "; " + note
-    return out
+        out["tissue_note"] = out["tissue_note"] + "; " + note.removeprefix("; ")
+    return mark_extrapolated(out, outside)

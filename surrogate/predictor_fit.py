@@ -4,7 +4,7 @@ The predictor is a :class:`SweepSurrogate` of the patient models (RSJ, RSF, THF)
 training sweeps' results (presets ``patient_space_rsj``, ``_rsf``, ``_thf``), with their tip-folded
 runs left out and counted, the noise floor of each output from the replicate sweeps
 (``_replicates``), and the reference wall (tissue stiffness 1) as the tissue of a query that names
-none. Its JSON says what it is (``about``): the sweeps it was fitted on and those held
+none. Its domain is each sweep's design range (:func:`design_domains`), where the runs reach it. Its JSON says what it is (``about``): the sweeps it was fitted on and those held
 out, the engine commits of the runs, the training domain of each model, the runs left out.
 """
 
@@ -16,6 +16,8 @@ import numpy as np
 import pandas as pd
 
 from colonsim.catalog import TISSUE_STIFFNESS
+from colonsim.insertion.study.sweep_presets import PATIENT_MODELS as DESIGNS, PATIENT_RANGES
+from colonsim.insertion.study.sweep_spec import LHS_DECIMALS
 from colonsim.surrogate.model import TIP_FOLDED, SweepSurrogate
 from colonsim.surrogate.predictor import SHIPPED
 from colonsim.surrogate.store import save_surrogate
@@ -41,6 +43,7 @@ def fit_predictor(tables: dict, held_out=(), replicates=None, targets=TARGETS, *
              pd.concat([check_results(t, f"sweep {name}") for name, t in replicates.items()], ignore_index=True))
     model = SweepSurrogate(targets=targets, segments=[s for s in PATIENT_MODELS if (table["segment"] == s).any()],
                            tissue=REFERENCE_TISSUE, replicates=pairs, **fit_options).fit(table)
+    design_domains(model)
     model.about_ = {
         "what": "the pain predictor shipped with colonsim: a surrogate over the patient space of each patient model",
         "sweeps": sorted(tables), "held_out_sweeps": sorted(held_out), "replicate_sweeps": sorted(replicates or {}),
@@ -49,6 +52,40 @@ def fit_predictor(tables: dict, held_out=(), replicates=None, targets=TARGETS, *
         f"{TIP_FOLDED}_left_out": model.training_["tip_folded"],
         "fitted": datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds"),
     }
+    return model
+
+
+def design_range(segment, name):
+    """The range the patient-space sweep of ``segment`` draws input ``name`` from (a results
+    column), and its training runs; None for an input it does not vary."""
+    inputs, own, runs, _ = DESIGNS[segment]
+    design = "stiffness_factor" if name == TISSUE_STIFFNESS else name
+    return (*own.get(design, PATIENT_RANGES[design]), runs) if design in inputs else None
+
+
+def design_domains(model):
+    """Widen each segment's domain (in place) from the runs' box to the sweep's design ranges.
+
+    A Latin hypercube of n runs puts one run in each of the n strata of every range, so the runs'
+    box falls short of the design range by less than one stratum (range / n) at either end, plus
+    the rounding of its values to :data:`LHS_DECIMALS`: a query at the edge of the design
+    (friction 0, the default of an insertion) is then at most that far from a run, where the GP
+    interpolates as it does between runs. Where the runs fall short of an end by more (a sweep not
+    of this design, or its end run lost: failed or tip-folded), the domain keeps the runs' bound.
+    The GP's input scaling is its own and is not changed."""
+    for segment, domain in model.domains_.items():
+        low, high = domain.low.copy(), domain.high.copy()
+        for j, name in enumerate(domain.inputs):
+            design = design_range(segment, name) if segment in DESIGNS else None
+            if design is None:
+                continue
+            lo, hi, runs = design
+            stratum = (hi - lo) / runs + 0.5 * 10.0 ** -LHS_DECIMALS
+            if lo <= low[j] <= lo + stratum:
+                low[j] = lo
+            if hi - stratum <= high[j] <= hi:
+                high[j] = hi
+        domain.low, domain.high = low, high  # new arrays: the GPs keep the runs' box as their scaling
     return model
 
 

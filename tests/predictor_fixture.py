@@ -23,12 +23,15 @@ def made_up_deformation(x):
             - 0.5 * (x[TISSUE_STIFFNESS] - 1.0))
 
 
-def synthetic_patient_table(n=40, seed=0, noise_cm=0.02, folded=0, bias_cm=0.0, shrink=0.0, segment="rsf"):
-    """A SYNTHETIC results table of ``n`` runs of ``segment`` (inputs uniform in :data:`RANGES`
-    shrunk by ``shrink`` of each range at either end); ``folded`` runs end with a folded tip
-    (and a wild value, which training must not see); ``bias_cm`` shifts every output."""
+def synthetic_patient_table(n=40, seed=0, noise_cm=0.02, folded=0, bias_cm=0.0, shrink=0.0, segment="rsf",
+                            ranges=None):
+    """A SYNTHETIC results table of ``n`` runs of ``segment`` (inputs uniform in :data:`RANGES`,
+    updated by ``ranges``, shrunk by ``shrink`` of each range at either end; a range (v, v) holds
+    the input at v); ``folded`` runs end with a folded tip (and a wild value, which training must
+    not see); ``bias_cm`` shifts every output."""
     rng = np.random.default_rng(seed)
-    x = {k: rng.uniform(lo + shrink * (hi - lo), hi - shrink * (hi - lo), n) for k, (lo, hi) in RANGES.items()}
+    x = {k: rng.uniform(lo + shrink * (hi - lo), hi - shrink * (hi - lo), n)
+         for k, (lo, hi) in {**RANGES, **(ranges or {})}.items()}
     largest = made_up_deformation(x) + bias_cm + rng.normal(0.0, noise_cm, n)
     final = 0.8 * largest + rng.normal(0.0, noise_cm, n)
     ended = np.array(["length_used"] * n, dtype=object)

@@ -42,7 +42,8 @@ LAYERS = {
     "colonsim.surrogate": WORKFLOW,
     "colonsim.workflows": TOP, "colonsim.cli": TOP, "colonsim.cli_sweep": TOP, "colonsim.cli_surrogate": TOP,
     "colonsim.cli_queries": TOP,
-    "colonsim.options": TOP, "colonsim.demo": TOP, "colonsim.cli_material": TOP, "colonsim.calibrate_modes": TOP,
+    "colonsim.options": TOP, "colonsim.demo": TOP, "colonsim.demo_predictor": TOP, "colonsim.demo_report": TOP,
+    "colonsim.demo_sweep": TOP, "colonsim.cli_material": TOP, "colonsim.calibrate_modes": TOP,
     "colonsim.api": TOP, "colonsim.api_calibration": TOP, "colonsim.api_insertion": TOP,
 }
 # The one upward import: the package's __init__ (ground) re-exports the public API (colonsim.api,

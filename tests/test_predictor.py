@@ -145,6 +145,7 @@ def test_the_patient_space_presets_parse_into_cases():
 
 def test_without_a_shipped_model_the_call_says_so_and_how_to_fit_one(tmp_path, monkeypatch, capsys):
     monkeypatch.setattr(predictor, "SHIPPED", tmp_path / "patient_space")
+    monkeypatch.delenv(predictor.OVERRIDE, raising=False)
     with pytest.raises(ColonsimError, match="ships no fitted predictor.*colonsim surrogate fit"):
         load_shipped()
     assert main(["predict", "--segment", "rsf", "--angle", "45", "--scope", "9.2", "--diameter", "36"]) == 2
@@ -177,7 +178,7 @@ def test_predict_inside_answers_outside_refuses_by_how_much_unless_extrapolating
                                  tissue_stiffness=1.0, model=model)
     row = inside.iloc[0]
     assert row["in_domain"] and row["max_deformation_cm_low95"] < row["max_deformation_cm"] < row["max_deformation_cm_high95"]
-    with pytest.raises(ColonsimError, match=r"angle_deg 75 outside 0\.\d+-59\.\d+ \(1\d\.\d* deg above\).*--extrapolate"):
+    with pytest.raises(ColonsimError, match=r"angle_deg 75 outside 0\.\d+-60 \(15 deg above\).*--extrapolate"):
         predict_deformation("rsf", "utc", angle_deg=75, diameter_mm=36, friction=0.05, distal_resistance_N=5,
                             model=model)
     with pytest.warns(OutOfDomainWarning, match="angle_deg 75"):
@@ -246,6 +247,19 @@ def test_the_cli_uses_the_shipped_model_and_marks_every_extrapolated_number(ship
     assert main(["predict", *patient, "--scope", "9.2", "--material",
                  str(material_file(tmp_path / "m.json", 3.0))]) == 2
     assert "tissue stiffness 3 outside" in capsys.readouterr().err
+    # a material inside: its stiffness and spread, nothing marked; outside with --extrapolate: every number marked
+    assert main(["predict", *patient, "--scope", "9.2", "--material", str(material_file(tmp_path / "i.json", 1.2))]) == 0
+    out = capsys.readouterr().out
+    assert "i.json maps to tissue stiffness 1.2 (sd 0.0" in out and "[EXTRAPOLATED]" not in out
+    stiff = str(material_file(tmp_path / "m.json", 3.0))
+    assert main(["predict", *patient, "--scope", "9.2", "--material", stiff, "--extrapolate"]) == 0
+    lines = [line for line in capsys.readouterr().out.splitlines() if "(95 %:" in line]
+    assert len(lines) == 2 and all("[EXTRAPOLATED]" in line for line in lines)
+    assert main(["recommend", *patient, "--material", stiff, "--extrapolate"]) == 0
+    text = capsys.readouterr().out
+    assert text.startswith("[EXTRAPOLATED] RSF") and all("[EXTRAPOLATED]" in line for line in text.splitlines()
+                                                        if " mm): " in line or "sd, cm" in line)
+    assert "tissue stiffness 3 outside" in text
 
 
 # -- the held-out table ----------------------------------------------------------------------------------
@@ -287,3 +301,59 @@ def test_the_shipped_predictor_reproduces_its_committed_held_out_table():
     assert [(r["model"], r["output"], r["runs"], r["coverage_95_ok"], r["coverage_50_ok"]) for r in rows] == \
         [(r["model"], r["output"], r["runs"], r["coverage_95_ok"], r["coverage_50_ok"]) for r in committed]
     assert [r["rmse"] for r in rows] == pytest.approx([r["rmse"] for r in committed], rel=1e-6)
+
+
+# -- the query's defaults, the domain of the design, the override, the light import ---------------------------
+
+def test_the_domain_widens_to_the_design_range_only_within_one_stratum_of_the_runs(shipped):
+    """The synthetic runs are uniform, not a hypercube: an end the runs reach within one stratum
+    (range / 72 runs) becomes the design's edge, an end they miss by more keeps the runs' bound."""
+    domain = load_shipped(shipped).domains_["rsf"]
+    table = synthetic_patient_table(n=72, folded=3).iloc[3:]
+    j = domain.inputs.index("angle_deg")
+    stratum = 60.0 / 72
+    assert table["angle_deg"].max() > 60.0 - stratum and domain.high[j] == 60.0
+    assert table["angle_deg"].min() > stratum and domain.low[j] == table["angle_deg"].min()
+
+
+def test_a_predictor_query_takes_the_insertions_defaults_and_says_so_a_users_model_does_not(shipped):
+    assert predictor.QUERY_DEFAULTS == {k: getattr(InsertionCase(), k) for k in predictor.QUERY_DEFAULTS}
+    model = load_shipped(shipped)
+    row = predict_deformation("rsf", "pdc", angle_deg=30, diameter_mm=36, model=model).iloc[0]
+    assert row["friction"] == 0.0 and row["distal_resistance_N"] == 5.0
+    assert "friction 0, distal_resistance_N 5 (colonsim insert's defaults" in row["tissue_note"]
+    given = predict_deformation("rsf", "pdc", angle_deg=30, diameter_mm=36, friction=0.05, model=model).iloc[0]
+    assert given["friction"] == 0.05 and "friction 0," not in given["tissue_note"]
+    model.about_ = None  # a model of the user's: every input named
+    with pytest.raises(ColonsimError, match="give friction"):
+        predict_deformation("rsf", "pdc", angle_deg=30, diameter_mm=36, model=model)
+
+
+def test_the_environment_variable_puts_another_model_in_the_shipped_ones_place(shipped, tmp_path, monkeypatch,
+                                                                                capsys):
+    monkeypatch.setattr(predictor, "SHIPPED", tmp_path / "none")
+    monkeypatch.setenv(predictor.OVERRIDE, str(shipped.with_suffix(".json")))
+    assert load_shipped().about_["sweeps"] == ["patient_space_rsf"]
+    assert main(["predict", "--segment", "rsf", "--angle", "45", "--scope", "9.2", "--diameter", "36"]) == 0
+    assert "(colonsim insert's defaults" in capsys.readouterr().out
+    monkeypatch.setenv(predictor.OVERRIDE, str(tmp_path / "missing"))
+    with pytest.raises(ColonsimError, match=f"{predictor.OVERRIDE}=.*missing: no model there.*unset it"):
+        load_shipped()
+
+
+def test_the_predict_command_imports_neither_numba_nor_the_insertion_engine(shipped):
+    """`colonsim predict` answers in about a second: it loads no solver module and no Numba (a
+    subprocess, so that nothing this test session imported counts)."""
+    import os
+    import subprocess
+
+    code = ("import sys\nfrom colonsim.cli import main\n"
+            "assert main(['predict', '--segment', 'rsf', '--angle', '45', '--scope', '9.2', '--diameter', '36']) == 0\n"
+            "print(sorted(m for m in sys.modules if m == 'numba' or m.startswith(('colonsim.insertion.engine.',"
+            " 'colonsim.insertion.case.', 'colonsim.insertion.anatomy.'))))\n")
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120,
+                          env={**os.environ, predictor.OVERRIDE: str(shipped)})
+    assert done.returncode == 0, done.stderr
+    loaded = eval(done.stdout.strip().splitlines()[-1])
+    # the material file reader and the tissue mapping it serves are plain Python over numpy
+    assert set(loaded) <= {"colonsim.insertion.engine.material", "colonsim.insertion.case.case_material"}, loaded

@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from colonsim.surrogate.gp import GaussianProcess, draws_for, SMALL_FIT_RUNS
-from colonsim.surrogate.hyperposterior import CURVATURE_FLOOR, DRAWS, FEW_ROWS, Mixture, laplace_draws
+from colonsim.surrogate.hyperposterior import CURVATURE_FLOOR, DRAWS, FEW_ROWS, Mixture, laplace_draws, loaded_loops
 from colonsim.surrogate.likelihood import log_marginal_likelihood
 from colonsim.surrogate.validation import loo_predictions
 
@@ -150,17 +150,23 @@ def test_mixture_batches_agree_with_single_queries():
 
 
 @pytest.mark.parametrize("with_var", [True, False])
-def test_few_rows_take_the_compiled_loop_and_give_the_numbers_of_the_batch(with_var):
-    """A query of a few rows (FEW_ROWS) is answered by one compiled loop, a batch by numpy: the
+def test_few_rows_take_the_compiled_loop_once_numba_is_loaded_and_give_the_numbers_of_the_batch(with_var):
+    """A query of a few rows (FEW_ROWS) is answered by one compiled loop once Numba is loaded, by
+    numpy before (a process that asks once), a batch by numpy around compiled covariances: the
     same mixture to round-off, at a training run (distance zero), near one and far away."""
     gp = fit(20)
     mix = gp.mixture_
     Q = np.vstack([gp.X_train_[3], gp.X_train_[5] + 1e-7, np.random.default_rng(1).random((FEW_ROWS - 3, 3)),
                    [3.0, -2.0, 0.5]])
     assert len(Q) == FEW_ROWS
+    import colonsim.surrogate.gp_loops  # noqa: F401  (loads Numba: the compiled loop answers)
+
+    assert loaded_loops() is not None
     compiled = mix.predict(Q, return_var=with_var)
     batch = mix._predict_rows(Q, with_var)
-    for got, want in zip(compiled if with_var else (compiled,), batch if with_var else (batch,)):
+    light = mix._predict_rows(Q, with_var, compiled=False)  # what a process without Numba answers
+    for got, want, plain in zip(*((r,) if not with_var else r for r in (compiled, batch, light))):
         np.testing.assert_allclose(got, want, rtol=1e-9, atol=1e-12)
+        np.testing.assert_allclose(plain, want, rtol=1e-9, atol=1e-12)
     one = mix.predict(Q[:1], return_var=with_var)
     np.testing.assert_allclose(one[0] if with_var else one, (batch[0] if with_var else batch)[:1], rtol=1e-9)
