@@ -1,7 +1,9 @@
 """colonsim: how much a colonoscope deforms the colon.
 
 The workflows as functions: :func:`calibrate`, :func:`insert`, :func:`sweep`,
-:func:`fit_surrogate`, :func:`predict`, :func:`recommend` (defined in :mod:`colonsim.api`). The
+:func:`fit_surrogate`, :func:`predict`, :func:`recommend` (defined in :mod:`colonsim.api`), and
+:func:`calibrate_strip`, :func:`calibrate_multimode`, :func:`export_cards`
+(:mod:`colonsim.api_calibration`) and :func:`simulate` (:mod:`colonsim.api_insertion`). The
 command line lives in :mod:`colonsim.cli`; the physics in the subpackages
 :mod:`colonsim.identification` (tissue calibration), :mod:`colonsim.insertion` (explicit
 insertion solver) and :mod:`colonsim.surrogate` (Gaussian-process surrogate).

@@ -96,21 +96,13 @@ def insert(segment="rsj", scope="sdc", *, out="colonsim_results/insertion", cent
     >>> len(runs), runs[0].summary["final_deformation_cm"] >= 0, "push_force_N" in runs[0].timeseries
     (1, True, True)
     """
-    from colonsim.insertion.case.insertion_case import InsertionCase
-    from colonsim.workflows import anatomy_inputs, insert as run
+    from colonsim.api_insertion import insertion_cases
+    from colonsim.workflows import insert as run
 
     scopes = [scope] if isinstance(scope, (str, int, float)) else list(scope)
     if not scopes:
         raise ColonsimError("give at least one scope (utc, pdc, sdc or an outer diameter in mm)")
-    for name in ("segment", "scope", "centerline"):
-        inputs.pop(name, None)
-    anatomy = anatomy_inputs(segment, None if centerline is None else Path(centerline),
-                             inputs.pop("diameter_mm", None), inputs.pop("centerline_smoothing_mm", None))
-    try:
-        cases = [InsertionCase(**anatomy, scope=str(s), **inputs) for s in scopes]
-    except TypeError as error:  # an unknown keyword
-        raise ColonsimError(f"{error}; the inputs are InsertionCase's fields (docs: reference, model parameters)")
-    return run(cases, Path(out), vtu=vtu, show=show_progress)
+    return run(insertion_cases(segment, scopes, centerline, inputs), Path(out), vtu=vtu, show=show_progress)
 
 
 def sweep(spec=None, *, preset=None, out=None, workers=1, retry_failed=False, show_progress=False):

@@ -65,12 +65,10 @@ def simulate(segment="rsj", scope="sdc", *, snapshot_interval_s=None, out=None, 
     (True, True, 3)
     """
     from colonsim.files import check_output_folder, output_set
-    from colonsim.insertion.case.insertion_case import InsertionCase
     from colonsim.insertion.case.results import write_insertion
     from colonsim.insertion.case.run_budget import DEFAULT_MAX_STEPS, check_run_budget
     from colonsim.insertion.case.scenario import run_insertion
     from colonsim.limits import OPTION_RANGES
-    from colonsim.workflows import anatomy_inputs
 
     if snapshot_interval_s is not None:
         low, high, what = OPTION_RANGES["--snapshot-every"]
@@ -82,15 +80,27 @@ def simulate(segment="rsj", scope="sdc", *, snapshot_interval_s=None, out=None, 
                             "colonsim.insert runs several")
     if out is not None:
         out = check_output_folder(Path(out))
-    anatomy = anatomy_inputs(segment, None if centerline is None else Path(centerline),
-                             inputs.pop("diameter_mm", None), inputs.pop("centerline_smoothing_mm", None))
-    try:
-        case = InsertionCase(**anatomy, scope=str(scope), **inputs)
-    except TypeError as error:  # an unknown keyword
-        raise ColonsimError(f"{error}; the inputs are InsertionCase's fields (docs: reference, model parameters)")
+    case, = insertion_cases(segment, [scope], centerline, inputs)
     check_run_budget(case, DEFAULT_MAX_STEPS if max_steps is None else max_steps, option="max_steps")
     result = run_insertion(case, snapshot_interval=snapshot_interval_s)
     if out is not None:
         with output_set(out) as stage:  # the folder's files replaced together when all are written
             write_insertion(result, stage)
     return result
+
+
+def insertion_cases(segment, scopes, centerline, inputs) -> list:
+    """The cases of ``scopes`` (names or diameters in mm) through ``segment`` (or a patient's
+    ``centerline``) with the other ``inputs`` (InsertionCase's fields; ``segment``, ``scope`` and
+    ``centerline`` among them are left out), as :func:`simulate` and :func:`colonsim.insert` take
+    them; an unknown field is one line."""
+    from colonsim.insertion.case.insertion_case import InsertionCase
+    from colonsim.workflows import anatomy_inputs
+
+    inputs = {k: v for k, v in inputs.items() if k not in ("segment", "scope", "centerline")}
+    anatomy = anatomy_inputs(segment, None if centerline is None else Path(centerline),
+                             inputs.pop("diameter_mm", None), inputs.pop("centerline_smoothing_mm", None))
+    try:
+        return [InsertionCase(**anatomy, scope=str(s), **inputs) for s in scopes]
+    except TypeError as error:  # an unknown keyword
+        raise ColonsimError(f"{error}; the inputs are InsertionCase's fields (docs: reference, model parameters)")
