@@ -130,8 +130,10 @@ def run_demo(options: DemoOptions) -> dict:
     report = write_report(out, calibration, live, predicted, seconds, size, swept)
     print_summary(calibration, live, predicted, options.target, swept)
     print(f"\ndemo finished in {time.perf_counter() - t0:.0f} s; report: {report}; every file in {out}/")
-    print("Next: `colonsim predict` and `colonsim recommend` ask the predictor about any patient in its domain; "
-          "`colonsim sweep --preset thesis` runs the source's 39 insertions.")
+    ask = ("`colonsim predict` and `colonsim recommend` ask the predictor about any patient in its domain"
+           if "no_predictions" not in predicted else
+           "`colonsim demo --sweep` fits a surrogate on a 12-run sweep of its own")
+    print(f"Next: {ask}; `colonsim sweep --preset thesis` runs the source's 39 insertions.")
     return {"calibration": calibration, "live": live, "predicted": predicted, "swept": swept, "size": size,
             "report": report}
 
