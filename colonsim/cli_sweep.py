@@ -21,8 +21,10 @@ def add_parser(sub):
                                    "into the same --out skips the runs already finished.")
     p.add_argument("spec", nargs="?", type=Path, help="sweep TOML file")
     p.add_argument("--preset", help="thesis (the source's 39 insertions), validation (the validation report's "
-                                    "24 extra runs), resistance (the distal resistance study, 136 runs) or smoke "
-                                    "(3 fast runs)")
+                                    "24 extra runs), resistance (the distal resistance study, 136 runs), smoke "
+                                    "(3 fast runs), patient_space (the shipped predictor's 354 runs: its nine "
+                                    "presets patient_space_MODEL[_heldout|_replicates], each into its own folder "
+                                    "under --out)")
     p.add_argument("--workers", type=worker_count, default=None,
                    help=f"local worker processes, one Numba thread each (default: the cores, {available_cores()} here)")
     p.add_argument("--scheduler", metavar="ADDR",
@@ -112,22 +114,42 @@ def cmd_sweep(args):
         check_scheduler(args.scheduler)
     from colonsim.insertion.case.run_budget import check_sweep_budget
     from colonsim.insertion.study.adaptive_sweep import ROUNDS
-    from colonsim.insertion.study.sweep import SweepStore, describe_cases, reusable_runs, run_sweep
     from colonsim.insertion.study.sweep_outcomes import dask_distributed
+    from colonsim.insertion.study.sweep_presets import PRESET_GROUPS
     from colonsim.insertion.study.sweep_spec import load_sweep
 
     if args.scheduler is not None and not args.dry_run:
         dask_distributed()  # so does a missing dask, before the sweep is announced or anything written
     workers = available_cores() if args.workers is None else args.workers
     settings = _adaptive_settings(args, workers)
+    where = f"Dask cluster {args.scheduler}" if args.scheduler else f"{workers} local process{'es' if workers > 1 else ''}"
+    if args.spec is None and args.preset in PRESET_GROUPS:
+        if settings is not None:
+            raise ColonsimError(f"--preset {args.preset} runs {len(PRESET_GROUPS[args.preset])} presets as they "
+                                "are; --adaptive takes one sweep")
+        base = args.out or check_output_folder(Path("colonsim_results") / f"sweep_{args.preset}")
+        names = PRESET_GROUPS[args.preset]
+        specs = [load_sweep(None, name) for name in names]  # every preset checked before any runs
+        for spec in specs:
+            check_sweep_budget(spec.cases, args.max_steps)
+        for spec in specs:
+            _one_sweep(args, spec, check_output_folder(base / spec.name), workers, where)
+        return
     spec = load_sweep(args.spec, args.preset)
     out = args.out or check_output_folder(Path("colonsim_results") / f"sweep_{spec.name}")
-    where = f"Dask cluster {args.scheduler}" if args.scheduler else f"{workers} local process{'es' if workers > 1 else ''}"
     if settings is not None:
         return _adaptive(args, spec, settings, out, workers, where)
     if (out / ROUNDS).is_file():
         raise ColonsimError(f"{out} holds an adaptive sweep; continue it with --adaptive --budget N, or give this "
                             "sweep another --out")
+    _one_sweep(args, spec, out, workers, where)
+
+
+def _one_sweep(args, spec, out, workers, where):
+    """Run (or with --dry-run, list) the sweep ``spec`` into ``out`` and print its report."""
+    from colonsim.insertion.case.run_budget import check_sweep_budget
+    from colonsim.insertion.study.sweep import SweepStore, describe_cases, reusable_runs, run_sweep
+
     if args.dry_run:
         check_sweep_budget(spec.cases, args.max_steps)
         store = SweepStore(out)

@@ -195,3 +195,7 @@ friction = [0.05]
 }
 PRESETS.update({f"patient_space_{m}" + (f"_{part}" if part else ""): patient_space(m, part)
                 for m in PATIENT_MODELS for part in ("", *PATIENT_PARTS)})
+# Presets run together by one name (``colonsim sweep --preset NAME``: each into its own folder
+# under --out, in this order): the shipped predictor's sweep, training runs first.
+PRESET_GROUPS = {"patient_space": tuple(f"patient_space_{m}" + (f"_{part}" if part else "")
+                                        for m in PATIENT_MODELS for part in ("", *PATIENT_PARTS))}
