@@ -237,7 +237,7 @@ class OneLineParser(argparse.ArgumentParser):
 def _add_demo(sub):
     from colonsim.insertion.case.insertion_case import InsertionCase
 
-    demo = sub.add_parser("demo", help="run the workflows on the bundled data (a few minutes on 2 cores)",
+    demo = sub.add_parser("demo", help="run the workflows on the bundled data (about 2 minutes on 2 idle cores)",
                           description="Calibrate on the bundled synthetic tensile data (reduced budget), run one "
                                       "insertion with the calibrated material, ask the predictor shipped with colonsim "
                                       "about that material for two patients and rank the scopes, and set the live run "

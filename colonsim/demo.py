@@ -1,4 +1,4 @@
-"""``colonsim demo``: the three workflows end to end on the bundled data, in a few minutes on 2 cores.
+"""``colonsim demo``: the three workflows end to end on the bundled data, in about 2 minutes on 2 idle cores.
 
 1. calibrate Mooney-Rivlin parameters from the bundled SYNTHETIC tensile curves (reduced budget);
 2. one live insertion with the material just calibrated: the standard colonoscope (SDC) through
