@@ -366,3 +366,11 @@ def test_the_predict_command_imports_neither_numba_nor_the_insertion_engine(ship
     loaded = eval(done.stdout.strip().splitlines()[-1])
     # the material file reader and the tissue mapping it serves are plain Python over numpy
     assert set(loaded) <= {"colonsim.insertion.engine.material", "colonsim.insertion.case.case_material"}, loaded
+
+
+def test_the_chance_of_a_coverage_tells_a_verdict_of_thirty_runs_from_luck():
+    # all 30 inside a calibrated 95 % interval happens one time in five: a FAILS that may be chance
+    assert bench_predictor.chance(1.0, 30, 0.95) == pytest.approx(0.40, abs=0.01)
+    assert bench_predictor.chance(21 / 30, 30, 0.5) == pytest.approx(0.043, abs=0.001)  # too wide: unlikely by chance
+    assert bench_predictor.chance(0.5, 30, 0.5) == pytest.approx(1.0)
+    assert bench_predictor.chance(5 / 30, 30, 0.5) < 1e-3
