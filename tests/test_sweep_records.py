@@ -183,20 +183,27 @@ def test_colonsim_sweep_resumes_in_an_unpacked_record(tmp_path, capsys):
     assert f"10 runs, 3 already in {tmp_path / 'again'}/" in capsys.readouterr().out
 
 
-def test_a_table_only_record_keeps_the_table_and_summaries_and_a_sweep_resumes_in_it(tmp_path, capsys):
-    """``pack --table-only`` (the patient-space sweeps, which the predictor reads by their tables):
-    no series, no shapes; unpacked, the table and summaries are back and a resumed sweep counts
-    the runs done."""
-    _sweep(tmp_path / "sweep", [K["k1"], K["k2"]], failed=[K["k3"]])
-    assert records.main(["pack", "--table-only", str(tmp_path / "sweep"), str(tmp_path / "record")]) == 0
-    kept = sorted(p.name for p in (tmp_path / "record" / "runs" / K["k1"]).iterdir())
-    assert kept == ["summary.json"]
+def test_a_record_without_series_keeps_the_table_and_summaries_and_a_sweep_resumes_in_it(tmp_path, capsys):
+    """``pack --no-series`` (the patient-space sweeps, which the predictor reads by their tables):
+    each run's summary alone; packed again, nothing is rewritten; unpacked, the table and summaries
+    are back and `colonsim sweep` counts those runs done."""
+    from colonsim.cli import main
+    from colonsim.insertion.study.sweep_spec import load_sweep
+
+    toml = ROOT / "benchmarks" / "sweeps" / "smoothness.toml"
+    spec = load_sweep(toml)
+    keys = [c.key() for c in spec.cases]
+    INPUTS.update({c.key(): input_row(c) for c in spec.cases[:3]})
+    _sweep(tmp_path / "sweep", keys[:3])
+    (tmp_path / "sweep" / "sweep.json").write_text(json.dumps(spec.document()), encoding="utf-8")
+    assert records.main(["pack", "--no-series", str(tmp_path / "sweep"), str(tmp_path / "record")]) == 0
+    assert sorted(p.name for p in (tmp_path / "record" / "runs" / keys[0]).iterdir()) == ["summary.json"]
     assert json.loads((tmp_path / "record" / "packed.json").read_text())[-1]["series"] is False
+    assert records.pack(tmp_path / "sweep", tmp_path / "record", series=False)["packed"] == 0  # held already
     records.unpack(tmp_path / "record", tmp_path / "again")
-    pd.testing.assert_frame_equal(pd.read_parquet(tmp_path / "again" / "results.parquet").drop(columns="timeseries_path"),
-                                  pd.read_parquet(tmp_path / "sweep" / "results.parquet").drop(columns="timeseries_path"))
-    assert (tmp_path / "again" / "runs" / K["k2"] / "summary.json").is_file()
-    assert not (tmp_path / "again" / "runs" / K["k2"] / "timeseries.csv").exists()
-    # packed with its series, the same folder gives a record with them (the two modes are one option apart)
-    records.pack(tmp_path / "sweep", tmp_path / "full")
-    assert (tmp_path / "full" / "runs" / K["k1"] / "series.parquet").is_file()
+    pd.testing.assert_frame_equal(pd.read_parquet(tmp_path / "again" / "results.parquet"),
+                                  pd.read_parquet(tmp_path / "sweep" / "results.parquet"))
+    assert not (tmp_path / "again" / "runs" / keys[1] / "timeseries.csv").exists()
+    capsys.readouterr()
+    assert main(["sweep", str(toml), "--dry-run", "--out", str(tmp_path / "again")]) == 0
+    assert f"10 runs, 3 already in {tmp_path / 'again'}/" in capsys.readouterr().out

@@ -22,7 +22,7 @@ for the 39), against 1.4 / 3.8 MB for an RSJ / RSF run folder.
 Use::
 
     python -m validation.sweep_records pack SWEEP_DIR RECORD_DIR     # add SWEEP_DIR's finished runs
-    python -m validation.sweep_records pack --table-only SWEEP_DIR RECORD_DIR   # their table and summaries only
+    python -m validation.sweep_records pack --no-series SWEEP_DIR RECORD_DIR    # their table and summaries
     python -m validation.sweep_records unpack RECORD_DIR SWEEP_DIR   # a sweep folder again
     python -m validation.sweep_records status [RECORDS_DIR]          # what each record holds
 
@@ -159,9 +159,9 @@ def pack(sweep_dir, record_dir, series=True) -> dict:
     A run is packed when its row says ok or failed; an ok run also needs its summary, time series
     and final shape in its run folder (else it is left out and named). A run the record holds
     already (the same key, finished at the same time) is left as it is, so that packing again
-    rewrites no file of it. ``series`` False keeps of each run its summary only (``--table-only``:
-    what a surrogate and a resumed sweep read, a few kB a run; the report's figures need the
-    series). Returns the counts."""
+    rewrites no file of it. ``series`` False keeps of each run its summary alone (``--no-series``:
+    what a surrogate and a resumed sweep read, about 13 kB a run; the report's figures need the
+    series and shapes). Returns the counts."""
     sweep, record, table, kept = _folders(sweep_dir, record_dir, "the folder of a sweep (its --out)")
     held = {r["key"]: r.get("finished_at") for r in kept.to_dict("records")}
     rows, incomplete = [], []
@@ -206,7 +206,7 @@ def unpack(record_dir, sweep_dir) -> dict:
                 target = stage / row["key"]
                 target.mkdir()
                 shutil.copyfile(source / RUN_SUMMARY, target / RUN_SUMMARY)
-                if (source / SERIES).is_file():  # a run packed --table-only has its summary only
+                if (source / SERIES).is_file():  # a run packed --no-series has its summary alone
                     unpack_series(pd.read_parquet(source / SERIES)).to_csv(target / RUN_SERIES, index=False)
                     with np.load(source / SHAPE, allow_pickle=False) as data:
                         np.savez_compressed(target / RUN_SHAPE, **unpack_shape({n: data[n] for n in data.files}))
@@ -234,8 +234,8 @@ def main(argv=None) -> int:
     p = sub.add_parser("pack", help="add a sweep folder's finished runs to a record")
     p.add_argument("sweep")
     p.add_argument("record")
-    p.add_argument("--table-only", action="store_true",
-                   help="keep of each run its summary only, not its time series and final shape (what a surrogate "
+    p.add_argument("--no-series", action="store_true",
+                   help="keep of each run its summary alone, not its time series and final shape (what a surrogate "
                         "and a resumed sweep read)")
     u = sub.add_parser("unpack", help="write a record as a sweep folder")
     u.add_argument("record")
@@ -251,7 +251,7 @@ def main(argv=None) -> int:
                 print(f"{s['record']}: sweep {s['sweep']!r}, {s['ok']} ok + {s['failed']} failed of "
                       f"{s['defined'] or '?'} defined; rows' code {code}")
         elif args.command == "pack":
-            done = pack(args.sweep, args.record, series=not args.table_only)
+            done = pack(args.sweep, args.record, series=not args.no_series)
             print(f"packed {done['packed']} runs into {args.record} ({done['rows']} in the record)"
                   + (f"; left out, their run folders incomplete: {', '.join(done['incomplete'])}"
                      if done["incomplete"] else ""))
