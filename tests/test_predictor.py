@@ -374,3 +374,10 @@ def test_the_chance_of_a_coverage_tells_a_verdict_of_thirty_runs_from_luck():
     assert bench_predictor.chance(21 / 30, 30, 0.5) == pytest.approx(0.043, abs=0.001)  # too wide: unlikely by chance
     assert bench_predictor.chance(0.5, 30, 0.5) == pytest.approx(1.0)
     assert bench_predictor.chance(5 / 30, 30, 0.5) < 1e-3
+
+
+
+def test_what_the_bands_ask_of_a_perfect_predictor_grows_with_the_held_out_runs():
+    both = [bench_predictor.pass_chance(n, 0.95, (0.88, 0.99)) * bench_predictor.pass_chance(n, 0.5, (0.38, 0.62))
+            for n in (30, 100)]
+    assert both[0] == pytest.approx(0.58, abs=0.01) and both[1] == pytest.approx(0.98, abs=0.01)
