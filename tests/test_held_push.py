@@ -68,3 +68,19 @@ def test_off_by_default_and_out_of_the_key_there():
             == InsertionCase(distal_resistance_N=0.0).key())
     with pytest.raises(ColonsimError, match=r"held_push_pace = 1.5 is outside \[0, 1\]"):
         InsertionCase(held_push_pace=1.5).validate()
+
+
+def test_the_paced_benchmark_judges_departures_by_the_rate_bounds_and_their_floors():
+    import sys
+    from pathlib import Path
+
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "benchmarks"))
+    from bench_paced import departures
+
+    old = {"point_A_cm": 2.0, "point_C_cm": 1.5, "final_deformation_cm": 0.05, "max_deformation_cm": 2.0,
+           "max_lag_cm": 6.0, "peak_contact_force_N": 20.0, "peak_push_force_N": 0.2}
+    new = {**old, "point_A_cm": 2.09, "point_C_cm": 1.6, "final_deformation_cm": 0.09, "peak_contact_force_N": 21.9,
+           "peak_push_force_N": 0.4}
+    found = {name: ok for name, _, ok in departures(new, old)}
+    assert found["A"] and not found["C"]  # +4.5 % within, +6.7 % beyond
+    assert found["contact"] and "push" not in found and "final" not in found  # below their floors: not judged
