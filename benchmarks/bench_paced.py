@@ -83,12 +83,12 @@ def main(argv=None) -> int:
                         f"({row['simulated_time_s'] / base['simulated_time_s'] - 1:+.1%})")
             found = departures(row, base)
             beyond += sum(not ok for _, _, ok in found)
-            line.append("against unpaced: " + _cells(found))
+            line.append("against unpaced: " + _cells(found) + f" (snap-throughs {row['snap_throughs']:g}, unpaced "
+                        f"{base['snap_throughs']:g})")
         if key in slow:
             found = departures(slow[key], row)
             beyond += sum(not ok for _, _, ok in found)
-            line.append(f"half speed: {_cells(found)}; snap-throughs {row['snap_throughs']:g} / "
-                        f"{slow[key]['snap_throughs']:g}")
+            line.append(f"half speed: {_cells(found)} (snap-throughs {slow[key]['snap_throughs']:g})")
         print("; ".join(line))
     print(f"{len(fast)} paced cases at {speed:g} m/s, {len(slow)} at {0.5 * speed:g} m/s; {beyond} departures beyond "
           "the rate bounds")
