@@ -164,18 +164,28 @@ def test_every_column_the_report_reads_is_recorded():
     assert asked <= set(records.SERIES_COLUMNS), asked - set(records.SERIES_COLUMNS)
 
 
+SMOOTHNESS = ROOT / "benchmarks" / "sweeps" / "smoothness.toml"
+
+
+def _smoothness_folder(folder) -> list:
+    """A sweep folder of three of the smoothness sweep's ten cases (its real sweep.json); their keys."""
+    from colonsim.insertion.study.sweep_spec import load_sweep
+
+    spec = load_sweep(SMOOTHNESS)
+    keys = [c.key() for c in spec.cases]
+    INPUTS.update({c.key(): input_row(c) for c in spec.cases[:3]})
+    _sweep(folder, keys[:3])
+    (folder / "sweep.json").write_text(json.dumps(spec.document()), encoding="utf-8")
+    return keys
+
+
 def test_colonsim_sweep_resumes_in_an_unpacked_record(tmp_path, capsys):
     """A record of three of the smoothness sweep's ten cases, unpacked: `colonsim sweep` counts them
     done and would run the other seven (a dry run: nothing is simulated)."""
     from colonsim.cli import main
-    from colonsim.insertion.study.sweep_spec import load_sweep
 
-    toml = ROOT / "benchmarks" / "sweeps" / "smoothness.toml"
-    spec = load_sweep(toml)
-    keys = [c.key() for c in spec.cases]
-    INPUTS.update({c.key(): input_row(c) for c in spec.cases[:3]})
-    _sweep(tmp_path / "sweep", keys[:3])
-    (tmp_path / "sweep" / "sweep.json").write_text(json.dumps(spec.document()), encoding="utf-8")
+    toml = SMOOTHNESS
+    _smoothness_folder(tmp_path / "sweep")
     records.pack(tmp_path / "sweep", tmp_path / "record")
     records.unpack(tmp_path / "record", tmp_path / "again")
     capsys.readouterr()
@@ -188,14 +198,9 @@ def test_a_record_without_series_keeps_the_table_and_summaries_and_a_sweep_resum
     each run's summary alone; packed again, nothing is rewritten; unpacked, the table and summaries
     are back and `colonsim sweep` counts those runs done."""
     from colonsim.cli import main
-    from colonsim.insertion.study.sweep_spec import load_sweep
 
-    toml = ROOT / "benchmarks" / "sweeps" / "smoothness.toml"
-    spec = load_sweep(toml)
-    keys = [c.key() for c in spec.cases]
-    INPUTS.update({c.key(): input_row(c) for c in spec.cases[:3]})
-    _sweep(tmp_path / "sweep", keys[:3])
-    (tmp_path / "sweep" / "sweep.json").write_text(json.dumps(spec.document()), encoding="utf-8")
+    toml = SMOOTHNESS
+    keys = _smoothness_folder(tmp_path / "sweep")
     assert records.main(["pack", "--no-series", str(tmp_path / "sweep"), str(tmp_path / "record")]) == 0
     assert sorted(p.name for p in (tmp_path / "record" / "runs" / keys[0]).iterdir()) == ["summary.json"]
     assert json.loads((tmp_path / "record" / "packed.json").read_text())[-1]["series"] is False
