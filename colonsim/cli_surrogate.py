@@ -241,12 +241,12 @@ def _check_material(model, segments, strict) -> dict:
 
 def cmd_predict(args):
     from colonsim.files import write_csv, write_json
-    from colonsim.surrogate.predictor import mark_extrapolated
     from colonsim.surrogate.model import SUFFIXES
+    from colonsim.surrogate.predictor import joined_notes, mark_extrapolated
 
     model, strict, note = load_model(args)
     frame, defaults = query_frame(args, model)
-    note = (note + defaults).removeprefix("; ")
+    note = joined_notes(note, defaults)
     outside = _check_material(model, frame["segment"], strict)
     targets = list(args.target or model.targets)
     unknown = sorted(set(targets) - set(model.targets))
@@ -279,14 +279,14 @@ def cmd_predict(args):
 def cmd_recommend(args):
     from colonsim.files import write_json
     from colonsim.surrogate.patients import describe_patient
-    from colonsim.surrogate.predictor import mark_extrapolated
+    from colonsim.surrogate.predictor import joined_notes, mark_extrapolated
     from colonsim.surrogate.recommend import format_recommendation, recommend
 
     model, strict, note = load_model(args)
     segment = _segment(args, model)
     outside = _check_material(model, [segment], strict)[segment]
     query, defaults = patient_query(model, segment, args, presets_of(args))
-    note = (note + defaults).removeprefix("; ")
+    note = joined_notes(note, defaults)
     rec = mark_extrapolated(recommend(model, segment, query, scopes=args.scope, target=args.target,
                                       reference=args.reference, strict=strict), outside)
     if note:

@@ -100,8 +100,14 @@ def defaults_note(defaults) -> str:
     """One phrase naming the defaults a query took ("" for none)."""
     if not defaults:
         return ""
-    return ("; " + ", ".join(f"{k} {v:g}" for k, v in defaults.items()) + " (colonsim insert's defaults; give "
+    return (", ".join(f"{k} {v:g}" for k, v in defaults.items()) + " (colonsim insert's defaults; give "
             + " / ".join(INPUT_OPTIONS[k] for k in defaults) + " for the patient's)")
+
+
+def joined_notes(*notes) -> str:
+    """The non-empty ``notes`` joined by "; " (a query's tissue note and its defaults' phrase, a row's
+    domain note and why it extrapolates)."""
+    return "; ".join(filter(None, notes))
 
 
 def with_material(model, material):
@@ -152,11 +158,11 @@ def mark_extrapolated(answer, outside: str, segment=None):
         answer["in_domain"] = False
         for s in answer["scopes"]:
             s["in_domain"] = False
-            s["domain_note"] = "; ".join(filter(None, (s["domain_note"], outside)))
+            s["domain_note"] = joined_notes(s["domain_note"], outside)
         return answer
     rows = answer.index if segment is None else answer.index[answer["segment"] == str(segment).lower()]
     answer.loc[rows, "in_domain"] = False
-    answer.loc[rows, "domain_note"] = ["; ".join(filter(None, (note, outside)))
+    answer.loc[rows, "domain_note"] = [joined_notes(note, outside)
                                        for note in answer.loc[rows, "domain_note"]]
     return answer
 
@@ -203,12 +209,12 @@ def predict_deformation(segment, scope=None, *, scope_diameter_mm=None, angle_de
     base = {"segment": str(segment).lower(), **{k: v for k, v in values.items() if v is not None}}
     defaults = query_defaults(model, segment, base)
     base.update(defaults)
-    note += defaults_note(defaults)
+    note = joined_notes(note, defaults_note(defaults))
     scopes = [scope] if isinstance(scope, (str, int, float)) else scope
     if scopes is None and scope_diameter_mm is None and base["segment"] in model.domains_:
         scopes = default_scopes(model.domains_[base["segment"]])
     frame = pd.DataFrame([{**base, "scope": str(s)} for s in scopes] if scopes else [base])
     out = model.predict_frame(frame, targets=list(targets), strict=not extrapolate)
     if note:
-        out["tissue_note"] = out["tissue_note"] + "; " + note.removeprefix("; ")
+        out["tissue_note"] = out["tissue_note"] + "; " + note
     return mark_extrapolated(out, outside)
