@@ -8,26 +8,30 @@ cases at the default speed without the pace (default: the record ``thesis_defaul
 `thesis` preset at the defaults and engine of 2026-12-07). Prints, per case at the default speed,
 its steps (simulated time, as the push sets the step count) against the unpaced run's, and the
 rate check's outputs (A, C, final and largest deformation, largest lag, peak contact and push
-forces) as departures from the unpaced run and from its own half-speed pair, each against the
-rate check's bounds (deformations 5 % above 0.1 cm, peak forces 10 % above 0.5 N:
-``colonsim.insertion.case.outcomes``); ``BEYOND`` marks a departure outside them.
+forces: the report's ``validation.sections.PAIR_QUANTITIES``) as departures from the unpaced run
+and from its own half-speed pair, each against the rate check's bounds (deformations 5 % above
+0.1 cm, peak forces 10 % above 0.5 N), every output in every model and without the report's rules
+for snap-throughs and neutral end states (the counts are printed beside); ``BEYOND`` marks a
+departure outside them.
 """
 
 from __future__ import annotations
 
 import argparse
+import math
+import sys
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
 
 from colonsim.insertion.case.insertion_case import InsertionCase
-from colonsim.insertion.case.outcomes import DEFORMATION_TOLERANCE, FORCE_FLOOR_N, FORCE_TOLERANCE
-from colonsim.insertion.study.claims import NO_DEFORMATION_CM
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # the validation package beside benchmarks/
+from validation.sections import PAIR_QUANTITIES  # noqa: E402  (the rate check's outputs, floors and bounds)
+from validation.sweeps import relative_change  # noqa: E402
 
 RECORD = Path(__file__).resolve().parent / "records" / "thesis_default_20261207"
-OUTPUTS = {"point_A_cm": "A", "point_C_cm": "C", "final_deformation_cm": "final", "max_deformation_cm": "largest",
-           "max_lag_cm": "lag", "peak_contact_force_N": "contact", "peak_push_force_N": "push"}
 CASE = ("segment", "scope", "angle_deg", "diameter_mm", "friction", "distal_resistance_N")
 
 
@@ -41,17 +45,14 @@ def _key(row) -> tuple:
 
 
 def departures(new, old) -> list:
-    """(output, relative departure of ``new`` from ``old``, within the bounds) of the rate
-    check's outputs that are measurable (above their floors) in either run."""
+    """(output, relative departure of ``new`` from ``old``, within the bounds) of each of the rate
+    check's outputs (:data:`validation.sections.PAIR_QUANTITIES`, every one in every model) that is
+    measurable (above its floor) in either run."""
     out = []
-    for column, name in OUTPUTS.items():
-        force = column.endswith("_N")
-        floor, bound = (FORCE_FLOOR_N, FORCE_TOLERANCE) if force else (NO_DEFORMATION_CM, DEFORMATION_TOLERANCE)
-        a, b = float(new[column]), float(old[column])
-        if not (np.isfinite(a) and np.isfinite(b)) or max(abs(a), abs(b)) < floor:
-            continue
-        change = (a - b) / max(abs(b), floor)
-        out.append((name, change, abs(change) <= bound))
+    for column, name, floor, bound in PAIR_QUANTITIES:
+        change = relative_change(float(old[column]), float(new[column]), floor)
+        if not math.isnan(change):
+            out.append((name, change, abs(change) <= bound))
     return out
 
 

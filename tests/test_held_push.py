@@ -83,4 +83,4 @@ def test_the_paced_benchmark_judges_departures_by_the_rate_bounds_and_their_floo
            "peak_push_force_N": 0.4}
     found = {name: ok for name, _, ok in departures(new, old)}
     assert found["A"] and not found["C"]  # +4.5 % within, +6.7 % beyond
-    assert found["contact"] and "push" not in found and "final" not in found  # below their floors: not judged
+    assert found["peak contact"] and "peak push" not in found and "final" not in found  # below their floors: not judged
