@@ -35,6 +35,11 @@ PATIENT_PARTS = {"heldout": (30, 100), "replicates": (10, 200)}
 REPLICATE_MESHES_MM = (3.0, 2.8)
 
 
+def patient_space_name(model: str, part: str = "") -> str:
+    """The preset name of ``model``'s patient-space sweep ``part`` ("" the training runs)."""
+    return f"patient_space_{model}" + (f"_{part}" if part else "")
+
+
 def patient_space(model: str, part: str = "") -> str:
     """The TOML of the patient-space sweep of ``model``: its training runs (``part`` ""), its
     held-out runs ("heldout") or its replicate pairs ("replicates").
@@ -57,7 +62,7 @@ def patient_space(model: str, part: str = "") -> str:
             "own scatter)")
         if part == "replicates":
             grid.append(f"element_size_mm = [{', '.join(f'{m:g}' for m in REPLICATE_MESHES_MM)}]")
-    name = f"patient_space_{model}" + (f"_{part}" if part else "")
+    name = patient_space_name(model, part)
     lines = ["[sweep]", f'name = "{name}"', f"seed = {seed}",
              f'description = "Patient space of {model.upper()}: {runs} {what}, a Latin hypercube over '
              f'{", ".join(inputs)}"', "", "[[grid]]", *grid, "", "[lhs]", f"samples = {runs}"]
@@ -193,9 +198,8 @@ scope = ["utc", "sdc"]
 friction = [0.05]
 """,
 }
-PRESETS.update({f"patient_space_{m}" + (f"_{part}" if part else ""): patient_space(m, part)
-                for m in PATIENT_MODELS for part in ("", *PATIENT_PARTS)})
+PATIENT_SPACE = tuple((m, part) for m in PATIENT_MODELS for part in ("", *PATIENT_PARTS))  # training runs first
+PRESETS.update({patient_space_name(m, part): patient_space(m, part) for m, part in PATIENT_SPACE})
 # Presets run together by one name (``colonsim sweep --preset NAME``: each into its own folder
 # under --out, in this order): the shipped predictor's sweep, training runs first.
-PRESET_GROUPS = {"patient_space": tuple(f"patient_space_{m}" + (f"_{part}" if part else "")
-                                        for m in PATIENT_MODELS for part in ("", *PATIENT_PARTS))}
+PRESET_GROUPS = {"patient_space": tuple(patient_space_name(m, part) for m, part in PATIENT_SPACE)}
