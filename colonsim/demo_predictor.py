@@ -8,14 +8,14 @@ and the demo goes on without predictions.
 from __future__ import annotations
 
 from colonsim.errors import ColonsimError
+from colonsim.surrogate.predictor import NOT_SHIPPED
 
 # Two patients at opposite corners of the patient space of RSJ (presets of surrogate/patients.py).
 PATIENTS = (
     {"label": "young African patient", "age": "young", "region": "african"},
     {"label": "older European patient (diverticular disease)", "age": "older", "region": "european"},
 )
-NO_PREDICTOR = ("this colonsim ships no fitted predictor yet (its patient-space sweeps have not been run); "
-                "'colonsim demo --sweep' fits a surrogate on a small sweep of its own instead")
+NO_PREDICTOR = f"{NOT_SHIPPED}; 'colonsim demo --sweep' fits a surrogate on a small sweep of its own instead"
 # the outputs the live run is set beside the predictor's answer for
 COMPARED = ("max_deformation_cm", "final_deformation_cm")
 # run settings the predictor's runs hold fixed: a live run at others is not the case they answer
