@@ -109,6 +109,7 @@ class SweepSurrogate:
         segments = self.segments or [s for s in dict.fromkeys(table["segment"]) if (table["segment"] == s).any()]
         self.domains_, self.models_, self.cv_, self.skipped_, self.notes_, self.scatter_ = {}, {}, {}, {}, [], {}
         self.about_ = None  # what a shipped predictor says of itself (colonsim.surrogate.predictor_fit)
+        self.held_out_ = {}  # segment -> output -> coverage on held-out runs (colonsim.surrogate.predictor_fit)
         folded = ((table["status"] == "ok") & (table["ended_by"] == TIP_FOLDED) if "ended_by" in table.columns
                   else pd.Series(False, index=table.index))
         if folded.any() and not self.tip_folded:  # counted in training_, said by report()
@@ -235,10 +236,11 @@ class SweepSurrogate:
 
     def error_unknown(self, segment, target) -> str | None:
         """Why the model of ``segment`` and ``target`` cannot state its error (too few runs to check
-        it), or None when its sd, intervals and probabilities are vouched for
-        (:func:`colonsim.surrogate.validation.error_unknown`)."""
+        it), or None when its sd, intervals and probabilities are vouched for: by its held-out runs
+        where it carries their coverage (``held_out_``, the shipped predictor), else by its
+        cross-validation (:func:`colonsim.surrogate.validation.error_unknown`)."""
         domain, gp = self.model_for(segment, target)
-        return error_unknown(self.cv_[domain.segment][target], gp)
+        return error_unknown(self.cv_[domain.segment][target], gp, self.held_out_.get(domain.segment, {}).get(target))
 
     def query(self, segment, values: dict) -> dict:
         """``values`` with scope names (key ``scope``) turned into ``scope_diameter_mm``; a diameter
@@ -322,7 +324,7 @@ class SweepSurrogate:
                 if gp is None:
                     continue
                 mean, std, std_tissue, std_surrogate = split_predict(gp, domain, Xm, tissue)
-                unknown = error_unknown(self.cv_[seg][t], gp)
+                unknown = self.error_unknown(seg, t)
                 if unknown:  # no number where the model cannot vouch for it
                     std = std_tissue = std_surrogate = np.full(len(mean), np.nan)
                     out.loc[rows.index, "error_note"] += f"{t}: {unknown}. "
@@ -359,7 +361,10 @@ class SweepSurrogate:
                 if scatter and not isinstance(gp, LargerOf):  # a larger-of model's parts have their own floors
                     lines.append(f"  {'':<22} noise floor {scatter['sd']:.2g} (scatter of {scatter['pairs']} replicate "
                                  f"pairs; their offset {scatter['offset']:+.2g})")
-                unknown = error_unknown(cv, gp)
+                unknown, held = self.error_unknown(seg, target), self.held_out_.get(seg, {}).get(target)
+                if held:
+                    lines.append(f"  {'':<22} held out: {held['runs']} runs, 95 % intervals covered "
+                                 f"{100 * held['coverage_95']:.0f} %, 50 % intervals {100 * held['coverage_50']:.0f} %")
                 if unknown:
                     lines.append(f"  {'':<22} {unknown}: its sd, intervals and probabilities are not printed")
             for target, why in self.skipped_[seg].items():

@@ -55,6 +55,20 @@ def fit_predictor(tables: dict, held_out=(), replicates=None, targets=TARGETS, *
     return model
 
 
+def vouch(model: SweepSurrogate, rows, sweeps):
+    """Store in ``model`` (in place) the coverage of its intervals on held-out runs: ``rows`` of the
+    held-out table (``benchmarks/bench_predictor.py``: model, output, runs, coverage_95,
+    coverage_50), scored on the sweeps named ``sweeps``. Where they are stored they decide whether
+    the model prints that output's intervals (:func:`colonsim.surrogate.validation.error_unknown`);
+    the runs themselves are never fitted on."""
+    model.held_out_ = {}
+    for row in rows:
+        model.held_out_.setdefault(row["model"], {})[row["output"]] = {
+            "runs": int(row["runs"]), "coverage_95": float(row["coverage_95"]),
+            "coverage_50": float(row["coverage_50"]), "sweeps": sorted(sweeps)}
+    return model
+
+
 def design_range(segment, name):
     """The range the patient-space sweep of ``segment`` draws input ``name`` from (a results
     column), and its training runs; None for an input it does not vary."""

@@ -29,14 +29,16 @@ from colonsim.surrogate.domain import SegmentDomain
 from colonsim.surrogate.gp import GaussianProcess
 from colonsim.surrogate.larger import LargerOf
 from colonsim.surrogate.model import SweepSurrogate
-from colonsim.surrogate.store_checks import IDENTITY, arrays_path, check_domain, check_draws, check_entry
+from colonsim.surrogate.store_checks import (IDENTITY, arrays_path, check_domain, check_draws, check_entry,
+                                             check_held_out)
 from colonsim.surrogate.tissue import TissueDistribution
 
 FORMAT = "colonsim-surrogate"
 # 1.2: the noise floor and scatter of replicate runs; the arrays say which segment and output they belong to
 # 1.3: an output that is the larger of two others is stored as their names ("larger_of"), without arrays
 # 1.4: the draws of the hyperparameters the prediction averages over ("draws", absent or empty: none)
-FORMAT_VERSION = "1.4"
+# 1.5: the coverage of an output's intervals on held-out runs ("held_out", absent: not measured)
+FORMAT_VERSION = "1.5"
 ARRAYS = ("X_train", "y_train", "alpha", "L")
 DRAWS = "draws"  # (draws, inputs + 2) log hyperparameters; the mixture is rebuilt from them on reading
 
@@ -82,6 +84,8 @@ def save_surrogate(model: SweepSurrogate, path, source=None, about=None):
                 "cross_validation": model.cv_[seg][target],
                 "noise_floor_sd": gp.noise_floor_sd, "scatter": model.scatter_[seg].get(target),
             }
+        for target, held in getattr(model, "held_out_", {}).get(seg, {}).items():
+            entries[target]["held_out"] = held
         segments[seg] = {"domain": domain.to_dict(), "models": entries, "skipped": model.skipped_[seg]}
     doc = {"format": FORMAT, "format_version": FORMAT_VERSION, "colonsim_version": __version__,
            "git_commit": code_version()["git_commit"],
@@ -149,6 +153,7 @@ def _read_pair(doc, json_path, npz_path) -> SweepSurrogate:
         model.about_ = doc.get("about")
         model.tissue_ = TissueDistribution.from_dict(doc.get("tissue"))  # files of format 1.0 hold none
         model.domains_, model.models_, model.cv_, model.skipped_, model.scatter_ = {}, {}, {}, {}, {}
+        model.held_out_ = {}
         with np.load(npz_path, allow_pickle=False) as arrays:
             for seg, entry in doc["segments"].items():
                 domain = SegmentDomain.from_dict(entry["domain"])
@@ -186,6 +191,8 @@ def _read_pair(doc, json_path, npz_path) -> SweepSurrogate:
                     model.cv_[seg][target] = m["cross_validation"]
                     model.scatter_[seg][target] = m.get("scatter")
                 model.models_[seg] = {t: model.models_[seg][t] for t in entry["models"]}  # the fit's order
+                model.held_out_[seg] = {t: check_held_out(m["held_out"], f"{json_path}: segment {seg}, {t}")
+                                        for t, m in entry["models"].items() if m.get("held_out") is not None}
     except ColonsimError:
         raise
     except (KeyError, TypeError, ValueError, AttributeError, OSError, EOFError, zipfile.BadZipFile) as exc:

@@ -106,3 +106,21 @@ def check_draws(draws, n_inputs, where):
         raise ColonsimError(f"{where}: array draws has shape {draws.shape} ({draws.dtype}), expected (draws, "
                             f"{n_inputs + 2}) finite log hyperparameters; refit the surrogate")
     return draws
+
+
+def check_held_out(held_out, where) -> dict:
+    """The coverage of an output's intervals on held-out runs: a positive whole run count, coverages
+    between 0 and 1 that are shares of it, the sweeps named (an edited count would vouch for
+    intervals no run checked)."""
+    try:
+        runs = held_out["runs"]
+        shares = {key: _finite(held_out[key], key, where) for key in ("coverage_95", "coverage_50")}
+        sweeps = [str(s) for s in held_out["sweeps"]]
+    except (KeyError, TypeError):
+        raise ColonsimError(f"{where}: its held-out record lacks runs, coverage_95, coverage_50 or sweeps; "
+                            "refit the surrogate") from None
+    if not isinstance(runs, int) or runs < 1 or any(not 0 <= v <= 1 or abs(v * runs - round(v * runs)) > 1e-6
+                                                    for v in shares.values()):
+        raise ColonsimError(f"{where}: its held-out record ({runs!r} runs, coverages {list(shares.values())}) is not "
+                            "a count of runs and shares of it; the model file is damaged or edited, refit the surrogate")
+    return {"runs": runs, **shares, "sweeps": sweeps}

@@ -18,7 +18,7 @@ The interval is that of a new simulation result (trend + scatter), the quantity 
 from __future__ import annotations
 
 import numpy as np
-from scipy.special import chdtri
+from scipy.special import bdtr, chdtri
 
 from colonsim.errors import ColonsimError
 from colonsim.surrogate.likelihood import inverse_from_cholesky
@@ -34,6 +34,11 @@ MIN_CHECKED_RUNS = 10  # fewer: the model cannot vouch for its error (measured, 
 # 100 held-out runs without replicates, 51 / 83 % with them; docs/surrogate.md "Without replicate
 # runs", "Rerun on 2026-12-01")
 MIN_RUNS_PER_INPUT = 10
+# held-out runs vouch for a model's intervals in place of its cross-validation (held_out_unknown)
+# from this many runs on: the number the shipped predictor is judged by per patient model
+MIN_HELD_OUT_RUNS = 30
+HELD_OUT_LEVELS = (("coverage_95", 0.95), ("coverage_50", 0.50))
+HELD_OUT_SIGNIFICANCE = 0.05  # so few covered runs happen this rarely with exact intervals: too narrow
 
 
 def metrics(y, mean, std):
@@ -47,11 +52,35 @@ def metrics(y, mean, std):
             "z_rms": float(np.sqrt(np.mean((err / np.asarray(std)) ** 2)))}
 
 
-def error_unknown(cv: dict, gp) -> str | None:
+def held_out_unknown(held_out: dict) -> str | None:
+    """Why the held-out runs ``held_out`` do not vouch for a model's intervals, or None when they do.
+
+    ``held_out``: {"runs", "coverage_95", "coverage_50", "sweeps"}, the coverage of the model's
+    nominal 95 % and 50 % intervals on runs never used in its fit. They do not vouch when the
+    intervals are too narrow: at either level so few runs covered that exact intervals would cover
+    that few or fewer with probability below :data:`HELD_OUT_SIGNIFICANCE` (one-sided binomial,
+    runs independent). Intervals too wide are conservative and stay stated; the held-out table
+    (``benchmarks/bench_predictor.py``) says so."""
+    n = int(held_out["runs"])
+    for key, nominal in HELD_OUT_LEVELS:
+        covered = int(round(float(held_out[key]) * n))
+        p = float(bdtr(covered, n, nominal))
+        if p < HELD_OUT_SIGNIFICANCE:
+            return (f"its {100 * nominal:.0f} % intervals covered {covered} of {n} held-out runs "
+                    f"({', '.join(held_out.get('sweeps', [])) or 'held-out sweeps'}), too few for intervals of "
+                    f"that level (p {p:.2g}); fit more runs")
+    return None
+
+
+def error_unknown(cv: dict, gp, held_out: dict | None = None) -> str | None:
     """Why the model cannot state its error, or None when it can (docs/surrogate.md, "Too few runs").
 
     ``cv``: its cross-validation metrics; ``gp``: the fitted :class:`GaussianProcess` (or
-    :class:`colonsim.surrogate.larger.LargerOf`, whose parts are checked). The error is unknown when
+    :class:`colonsim.surrogate.larger.LargerOf`, whose parts are checked); ``held_out``: the
+    coverage of its intervals on at least :data:`MIN_HELD_OUT_RUNS` held-out runs, or None. Where
+    held-out runs measured it, they decide (:func:`held_out_unknown`): a direct measure of the
+    intervals, where the rules below are signs that cross-validation cannot be trusted to. Else
+    the error is unknown when
 
     - fewer than :data:`MIN_CHECKED_RUNS` runs were predicted without themselves;
     - the noise sits at the bottom of its range: the fit explained the runs' scatter by short
@@ -69,6 +98,8 @@ def error_unknown(cv: dict, gp) -> str | None:
       their squares above the 95th percentile of a chi-square with as many degrees of freedom (a
       model whose sd is right exceeds it one time in twenty).
     """
+    if held_out is not None and int(held_out["runs"]) >= MIN_HELD_OUT_RUNS:
+        return held_out_unknown(held_out)
     n, z_rms = int(cv["n"]), cv.get("z_rms")
     if z_rms is None:
         return "its error was not cross-checked (a model of an older colonsim); refit it"

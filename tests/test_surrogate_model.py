@@ -92,7 +92,7 @@ def test_out_of_domain_warns_and_strict_raises(model):
 def test_save_load_round_trip_without_pickle(model, tmp_path):
     json_path, npz_path = save_surrogate(model, tmp_path / "model", source="results.parquet")
     doc = json.loads(json_path.read_text())
-    assert doc["format"] == "colonsim-surrogate" and doc["format_version"] == "1.4"
+    assert doc["format"] == "colonsim-surrogate" and doc["format_version"] == "1.5"
     assert doc["segments"]["rsj"]["domain"]["fixed"]["angle_deg"] == 0.0
     assert set(doc["segments"]["rsj"]["models"]["max_deformation_cm"]["cross_validation"]) >= {
         "rmse", "max_abs_error", "coverage_95"}

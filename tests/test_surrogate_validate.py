@@ -222,3 +222,53 @@ def test_fit_with_replicates_on_the_command_line(train, tmp_path, capsys):
         main(["surrogate", "info", str(tmp_path / "model.json")]) or capsys.readouterr().out)
     doc = json.loads((tmp_path / "model.json").read_text())
     assert doc["segments"]["rsj"]["models"][TARGET]["scatter"]["pairs"] == 5
+
+
+# -- held-out runs vouch for the intervals (the shipped predictor) -----------------------------------
+def held_out_rows(model, held):
+    """The rows of a held-out table for ``model`` on the runs ``held`` (benchmarks/bench_predictor.py's fields)."""
+    s = score(model, held, TARGET, "rsj")
+    return [{"model": "rsj", "output": TARGET, "runs": s["n"], "coverage_95": s["coverage"]["95"],
+             "coverage_50": s["coverage"]["50"]}]
+
+
+def test_held_out_runs_decide_whether_intervals_are_printed(known, tmp_path):
+    """Where a model carries the coverage of its intervals on at least 30 held-out runs, that
+    coverage decides, both ways: a 29-run model that cross-validation cannot vouch for (fewer than
+    10 runs per input) prints its intervals once 40 held-out runs bear them out; a model fitted on
+    runs without scatter (its noise at the bottom of its range) does not, and the reason names the
+    held-out coverage. Fewer than 30 held-out runs leave the cross-validation rule in charge. The
+    record survives the files; an edited one is refused."""
+    from colonsim.surrogate.predictor_fit import vouch
+    from colonsim.surrogate.store import load_surrogate, save_surrogate
+
+    held = rsj(40, seed=21)
+    small = SweepSurrogate(targets=(TARGET,), n_restarts=1).fit(known.iloc[:29])
+    assert small.error_unknown("rsj", TARGET).startswith("too few runs to know its error (29 < 10 per input")
+    vouch(small, held_out_rows(small, held), ["synthetic_heldout"])
+    assert small.error_unknown("rsj", TARGET) is None
+    assert "held out: 40 runs, 95 % intervals covered" in small.report()
+    clean = SweepSurrogate(targets=(TARGET,), n_restarts=1).fit(rsj(30, seed=11, noise=0.0))
+    vouch(clean, held_out_rows(clean, held), ["synthetic_heldout"])
+    why = clean.error_unknown("rsj", TARGET)
+    assert why.startswith("its 95 % intervals covered ") and "of 40 held-out runs (synthetic_heldout)" in why
+    few = SweepSurrogate(targets=(TARGET,), n_restarts=1).fit(known.iloc[:29])
+    vouch(few, held_out_rows(few, held.iloc[:25]), ["synthetic_heldout"])
+    assert few.error_unknown("rsj", TARGET).startswith("too few runs to know its error (29 < 10 per input")
+    json_path, _ = save_surrogate(small, tmp_path / "model")
+    assert load_surrogate(json_path).error_unknown("rsj", TARGET) is None
+    doc = json.loads(json_path.read_text())
+    doc["segments"]["rsj"]["models"][TARGET]["held_out"]["runs"] = 41  # 95 % coverage no longer a share of it
+    json_path.write_text(json.dumps(doc))
+    with pytest.raises(ColonsimError, match="held-out record .* is not a count of runs and shares of it"):
+        load_surrogate(json_path)
+
+
+def test_held_out_intervals_too_narrow_at_either_level_are_not_vouched_for():
+    from colonsim.surrogate.validation import held_out_unknown
+
+    record = {"runs": 30, "coverage_95": 29 / 30, "coverage_50": 15 / 30, "sweeps": ["s"]}
+    assert held_out_unknown(record) is None
+    assert held_out_unknown({**record, "coverage_95": 1.0, "coverage_50": 25 / 30}) is None  # too wide: stated
+    assert "95 % intervals covered 25 of 30 held-out runs (s), too few" in held_out_unknown({**record, "coverage_95": 25 / 30})
+    assert "50 % intervals covered 9 of 30" in held_out_unknown({**record, "coverage_50": 9 / 30})
