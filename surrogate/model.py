@@ -225,14 +225,23 @@ class SweepSurrogate:
         """The training domain and GP of ``segment`` and ``target``; a one-line error if there is none."""
         segment = str(segment).lower()
         if segment not in self.domains_:
-            raise ColonsimError(f"the surrogate has no model of segment {segment!r}; it was fitted on "
-                                f"{', '.join(self.domains_)}")
+            raise self.no_model_of(segment)
         model = self.models_[segment].get(target)
         if model is None:
             why = self.skipped_[segment].get(target, "not among the fitted targets")
             raise ColonsimError(f"no {target} model for {segment} ({why}); choose --target among "
                                 f"{', '.join(self.models_[segment]) or 'none'}")
         return self.domains_[segment], model
+
+    def no_model_of(self, segment) -> ColonsimError:
+        """The error for a query of a segment the model has no domain of: which it covers, and for
+        the shipped predictor (an ``about_``) which sweeps it was fitted on."""
+        covered = ", ".join(self.domains_)
+        if getattr(self, "about_", None):
+            return ColonsimError(f"the predictor has no model of segment {segment!r}: it covers {covered}, fitted on "
+                                 f"the sweeps {', '.join(self.about_.get('sweeps', []))}; ask one of those, or fit a "
+                                 "surrogate on a sweep of your own ('colonsim surrogate fit RESULTS -o MODEL')")
+        return ColonsimError(f"the surrogate has no model of segment {segment!r}; it was fitted on {covered}")
 
     def error_unknown(self, segment, target) -> str | None:
         """Why the model of ``segment`` and ``target`` cannot state its error (too few runs to check
@@ -309,7 +318,7 @@ class SweepSurrogate:
                 out[t + suffix] = np.nan
         for seg, rows in frame.groupby("segment", sort=False):
             if seg not in self.domains_:
-                raise ColonsimError(f"the surrogate has no model of segment {seg!r}; it was fitted on {', '.join(self.domains_)}")
+                raise self.no_model_of(seg)
             domain = self.domains_[seg]
             values = self.query(seg, {c: rows[c].to_numpy() for c in rows.columns if c != "segment"})
             values, tissue = plan(domain, values, len(rows), getattr(self, "tissue_", None), strict)

@@ -196,6 +196,15 @@ def test_predict_inside_answers_outside_refuses_by_how_much_unless_extrapolating
     assert not out.iloc[0]["in_domain"] and "angle_deg 75" in out.iloc[0]["domain_note"]
 
 
+def test_a_patient_model_the_predictor_was_not_fitted_on_is_refused_naming_what_it_covers(shipped, capsys, monkeypatch):
+    monkeypatch.setenv(predictor.OVERRIDE, str(shipped))
+    assert main(["predict", "--segment", "thf", "--angle", "30", "--scope", "9.2", "--diameter", "36"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err == ("colonsim: error: the predictor has no model of segment 'thf': it covers rsf, fitted on the sweeps "
+                   "patient_space_rsf; ask one of those, or fit a surrogate on a sweep of your own "
+                   "('colonsim surrogate fit RESULTS -o MODEL')")
+
+
 def test_a_material_maps_to_its_stiffness_with_its_uncertainty_in_the_interval(shipped, tmp_path):
     model = load_shipped(shipped)
     query = dict(angle_deg=30, diameter_mm=36, friction=0.05, distal_resistance_N=5, model=model)
@@ -310,6 +319,10 @@ def test_the_shipped_predictor_reproduces_its_committed_held_out_table():
     assert [(r["model"], r["output"], r["runs"], r["coverage_95_ok"], r["coverage_50_ok"]) for r in rows] == \
         [(r["model"], r["output"], r["runs"], r["coverage_95_ok"], r["coverage_50_ok"]) for r in committed]
     assert [r["rmse"] for r in rows] == pytest.approx([r["rmse"] for r in committed], rel=1e-6)
+    stored = load_shipped().held_out_  # the coverage that decides which outputs print intervals
+    assert [(stored[r["model"]][r["output"]]["runs"], stored[r["model"]][r["output"]]["coverage_95"],
+             stored[r["model"]][r["output"]]["coverage_50"]) for r in rows] == \
+        [(r["runs"], r["coverage_95"], r["coverage_50"]) for r in committed]
 
 
 # -- the query's defaults, the domain of the design, the override, the light import ---------------------------
