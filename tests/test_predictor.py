@@ -297,6 +297,35 @@ def test_the_held_out_table_passes_honest_runs_and_fails_biased_ones(shipped):
 
 
 
+def test_the_fit_stores_its_held_out_coverage_which_then_decides_the_intervals(tmp_path, capsys, monkeypatch):
+    """benchmarks/fit_predictor.py scores the held-out sweeps and stores their coverage per output:
+    honest held-out runs let the predictor print intervals; held-out runs 0.3 cm above every
+    prediction (what a biased model meets) make it print the means with the reason instead."""
+    import fit_predictor
+
+    sweeps = {"patient_space_rsf": synthetic_patient_table(n=72, folded=3),
+              "honest/patient_space_rsf_heldout": synthetic_patient_table(n=32, seed=8, shrink=0.05),
+              "biased/patient_space_rsf_heldout": synthetic_patient_table(n=32, seed=8, shrink=0.05, bias_cm=0.3)}
+    for name, table in sweeps.items():
+        (tmp_path / name).mkdir(parents=True)
+        table.to_parquet(tmp_path / name / "results.parquet")
+    monkeypatch.setattr(fit_predictor, "fit_predictor", lambda *a, **k: fit_predictor_fast(*a, **k))
+    for kind in ("honest", "biased"):
+        out = tmp_path / kind / "model" / "patient_space"
+        assert fit_predictor.main(["--train", str(tmp_path / "patient_space_rsf"), "--replicates", "--heldout",
+                                   str(tmp_path / kind / "patient_space_rsf_heldout"), "--out", str(out)]) == 0
+        model = load_shipped(out)
+        held = model.held_out_["rsf"]["max_deformation_cm"]
+        assert held["runs"] == 32 and held["sweeps"] == ["patient_space_rsf_heldout"]
+        why = model.error_unknown("rsf", "max_deformation_cm")
+        assert (why is None) == (kind == "honest"), why
+    assert capsys.readouterr().out.count("held out: 32 runs, 95 % intervals covered") == 4  # two outputs, two fits
+
+
+def fit_predictor_fast(tables, **options):
+    return fit_predictor(tables, **{**options, "targets": DEFORMATIONS, **FAST})
+
+
 def test_the_bench_prints_the_table_and_says_in_one_line_when_there_is_nothing_to_score(shipped, tmp_path, capsys,
                                                                                           monkeypatch):
     synthetic_patient_table(n=40, seed=3, shrink=0.05).to_parquet(tmp_path / "heldout.parquet")
