@@ -354,6 +354,29 @@ def test_the_shipped_predictor_reproduces_its_committed_held_out_table():
         [(r["runs"], r["coverage_95"], r["coverage_50"]) for r in committed]
 
 
+@pytest.mark.skipif(not predictor.shipped_exists(), reason="no predictor is shipped yet (the patient-space sweeps "
+                    "have not been run)")
+def test_the_shipped_predictor_refuses_a_point_outside_its_domain_and_a_tampered_file(tmp_path, monkeypatch):
+    monkeypatch.delenv(predictor.OVERRIDE, raising=False)
+    model = load_shipped()
+    for segment in model.domains_:
+        with pytest.raises(ColonsimError, match=r"scope_diameter_mm 20 outside 9-13\.5 \(6\.5 mm above\)"):
+            predict_deformation(segment, scope_diameter_mm=20, diameter_mm=30, angle_deg=30, model=model)
+    for suffix in (".json", ".npz"):
+        (tmp_path / f"patient_space{suffix}").write_bytes(predictor.SHIPPED.with_name(f"patient_space{suffix}").read_bytes())
+    doc = json.loads((tmp_path / "patient_space.json").read_text())
+    segment = next(iter(doc["segments"]))
+    doc["segments"][segment]["models"]["final_deformation_cm"]["noise_level"] = float("nan")
+    (tmp_path / "patient_space.json").write_text(json.dumps(doc))
+    with pytest.raises(ColonsimError, match="noise_level.*not finite"):
+        load_shipped(tmp_path / "patient_space")
+    arrays = bytearray((tmp_path / "patient_space.npz").read_bytes())
+    arrays[len(arrays) // 2] ^= 0xFF
+    (tmp_path / "patient_space.npz").write_bytes(bytes(arrays))
+    with pytest.raises(ColonsimError, match="does not belong to .* \\(checksum differs\\)"):
+        load_shipped(tmp_path / "patient_space")
+
+
 # -- the query's defaults, the domain of the design, the override, the light import ---------------------------
 
 def test_the_domain_widens_to_the_design_range_only_within_one_stratum_of_the_runs(shipped):
