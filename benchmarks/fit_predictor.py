@@ -39,8 +39,9 @@ def _tables(paths) -> dict:
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--train", type=Path, nargs="+",
-                        default=[RECORDS / f"patient_space_{m}" for m in PATIENT_MODELS],
-                        help="training sweep folders (or results tables), one per patient model")
+                        default=[p for m in PATIENT_MODELS if (p := RECORDS / f"patient_space_{m}").exists()],
+                        help="training sweep folders (or results tables), one per patient model (default: the "
+                             "committed records there are)")
     parser.add_argument("--replicates", type=Path, nargs="*",
                         default=[p for m in PATIENT_MODELS if (p := RECORDS / f"patient_space_{m}_replicates").exists()],
                         help="replicate sweep folders (or tables): cases at two wall meshes, the noise floor")
