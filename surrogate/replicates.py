@@ -55,7 +55,10 @@ def replicate_scatter(runs: pd.DataFrame, replicates: pd.DataFrame, segment, inp
         pool = pool.drop_duplicates(subset="key")
     y = numeric_column(pool, target).to_numpy(dtype=float)
     settings = [c for c in pool.columns if c not in NOT_SETTINGS and c not in inputs]
-    signature = pool[settings].astype(str).agg("|".join, axis=1).to_numpy() if settings else np.full(len(pool), "")
+    # map(str), not astype(str): pandas 3 keeps a missing value missing through astype(str), and a
+    # setting one table lacks is missing in the pool
+    signature = (pool[settings].apply(lambda column: column.map(str)).agg("|".join, axis=1).to_numpy()
+                 if settings else np.full(len(pool), ""))
     groups = {}
     for i, key in enumerate(_keys(pool, inputs)):
         if np.isfinite(y[i]):

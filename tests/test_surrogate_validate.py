@@ -75,6 +75,14 @@ def test_too_few_replicate_pairs_is_an_error(train):
         replicate_scatter(runs, reps, "rsj", ["scope_diameter_mm", "diameter_mm", "friction"], TARGET)
 
 
+def test_replicate_pairs_are_found_when_one_table_has_a_setting_the_other_lacks(train):
+    """Runs scored against replicates written by another colonsim (a results column the runs lack,
+    missing in their rows of the pool): the pairs are found, the missing setting read as a value."""
+    reps = replicates_of(train, 12, seed=13).assign(held_push_pace=0.0)
+    inputs = ["scope_diameter_mm", "diameter_mm", "friction"]
+    found = replicate_scatter(successful_runs(train, "rsj"), reps, "rsj", inputs, TARGET)
+    assert found["pairs"] == 12 and found["unpaired"] == 0
+
 def test_heldout_score_is_calibrated_with_the_right_noise(floored, test_table):
     s = score(floored, test_table, TARGET)
     assert s["n"] == 40 and s["n_train"] == 24
