@@ -216,8 +216,9 @@ def predict(model=None, segment=None, *, targets=None, strict=None, material=Non
     """Predict outputs at the given inputs: one row per combination of scopes given.
 
     ``model`` is a fitted surrogate, the path of its JSON file, or None: the predictor shipped
-    with colonsim, over the patient space of RSJ, RSF and THF, whose friction and distal
-    resistance default to ``colonsim insert``'s (0 and 5 N). ``inputs`` are the model's inputs
+    with colonsim, over the patient space of the patient models it was fitted on (``colonsim
+    surrogate info`` names them), whose friction and distal resistance default to ``colonsim
+    insert``'s (0 and 5 N). ``inputs`` are the model's inputs
     (``scope`` or ``scope_diameter_mm``, ``diameter_mm``, ``angle_deg``, ``friction``,
     ``distal_resistance_N``, ``tissue_stiffness``, ...; a list for several queries);
     ``material``, a calibrated ``material.json``, gives the tissue (its stiffness factor, its

@@ -1,7 +1,7 @@
 """Fit the shipped pain predictor on the patient-space sweeps and store it as package data.
 
-The predictor is a :class:`SweepSurrogate` of the patient models (RSJ, RSF, THF) fitted on the
-training sweeps' results (presets ``patient_space_rsj``, ``_rsf``, ``_thf``), with their tip-folded
+The predictor is a :class:`SweepSurrogate` of the patient models (RSJ, RSF, THF) whose training
+sweeps it is given (presets ``patient_space_rsj``, ``_rsf``, ``_thf``), fitted on their results, with their tip-folded
 runs left out and counted, the noise floor of each output from the replicate sweeps
 (``_replicates``), and the reference wall (tissue stiffness 1) as the tissue of a query that names
 none. Its domain is each sweep's design range (:func:`design_domains`), where the runs reach it. Its JSON says what it is (``about``): the sweeps it was fitted on and those held
@@ -45,7 +45,8 @@ def fit_predictor(tables: dict, held_out=(), replicates=None, targets=TARGETS, *
                            tissue=REFERENCE_TISSUE, replicates=pairs, **fit_options).fit(table)
     design_domains(model)
     model.about_ = {
-        "what": "the pain predictor shipped with colonsim: a surrogate over the patient space of each patient model",
+        "what": "the pain predictor shipped with colonsim: a surrogate over the patient space of "
+                + ", ".join(seg.upper() for seg in model.domains_),
         "sweeps": sorted(tables), "held_out_sweeps": sorted(held_out), "replicate_sweeps": sorted(replicates or {}),
         "engine_commits": model.training_["git_commits"],
         "domain": {seg: domain.describe() for seg, domain in model.domains_.items()},
