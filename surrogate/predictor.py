@@ -48,7 +48,7 @@ OVERRIDE = "COLONSIM_PREDICTOR"
 QUERY_DEFAULTS = {"friction": 0.0, "distal_resistance_N": 5.0}
 # the outputs the predictor answers by default: the pain proxy and the final deformation
 DEFORMATIONS = ("max_deformation_cm", "final_deformation_cm")
-NOT_SHIPPED = "this colonsim ships no fitted predictor yet (its patient-space sweeps have not been run)"
+NOT_SHIPPED = "this colonsim ships no fitted predictor (its package data lack predictor/patient_space.json)"
 NO_SHIPPED = (f"{NOT_SHIPPED}; give a model file, fitted with 'colonsim sweep --preset patient_space_rsj --out PS' "
               "and 'colonsim surrogate fit PS/results.parquet -o MODEL'")
 

@@ -129,7 +129,7 @@ def test_without_a_predictor_the_demo_says_so_in_one_line_and_predicts_nothing(t
         {"no_predictions": NO_PREDICTOR}
     lines = capsys.readouterr().out.strip().splitlines()
     assert lines[0] == "== 1/4 the predictor shipped with colonsim: the calibrated material's patients, the scopes ranked"
-    assert len(lines) == 2 and lines[1].startswith("no predictions: this colonsim ships no fitted predictor yet")
+    assert len(lines) == 2 and lines[1].startswith("no predictions: this colonsim ships no fitted predictor (")
 
 
 def test_a_material_outside_the_predictors_domain_gets_no_predictions_and_one_line(tmp_path, capsys, monkeypatch):
