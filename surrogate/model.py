@@ -146,12 +146,12 @@ class SweepSurrogate:
             if varying_settings:
                 self.notes_.append(f"{segment}: solver setting(s) {', '.join(varying_settings)} vary between runs; "
                                    "they are not inputs, so their effect shows up as scatter")
-            # tables of older code hold the check without the scope's imposed sliding in its own column;
-            # today's "quasi_static" is that check
+            # today's "quasi_static" is the ringing criterion; tables of older code hold their check in
+            # a column of its own
             check = next((c for c in ("quasi_static_without_imposed_sliding", "quasi_static") if c in runs.columns), None)
             if check is not None and (runs[check] == False).any():  # noqa: E712 (NaN-safe)
                 self.notes_.append(f"{segment}: {int((runs[check] == False).sum())} of {len(runs)} runs "  # noqa: E712
-                                   "were not quasi-static (KE/IE check without the scope's imposed sliding); "
+                                   "were not quasi-static (their push force rang: docs/quasi_static.md); "
                                    "they train like the others")
             self.models_[segment], self.cv_[segment], self.skipped_[segment] = {}, {}, {}
             self.scatter_[segment] = {}

@@ -274,3 +274,15 @@ def test_scope_names_fill_missing_diameters(model):
     values = model.query("rsj", {"scope": np.array(["utc", None, "sdc"], dtype=object),
                                  "scope_diameter_mm": np.array([np.nan, 10.0, np.nan])})
     np.testing.assert_array_equal(values["scope_diameter_mm"], [9.2, 10.0, 12.8])
+
+
+def test_runs_whose_push_force_rang_are_counted_in_the_notes_and_trained_on():
+    table = synthetic_sweep(design="grid", segments=("rsj",), seed=2)
+    table["quasi_static"] = True
+    quiet = SweepSurrogate(targets=("max_deformation_cm",), n_restarts=0).fit(table)
+    assert not any("quasi-static" in note for note in quiet.notes_)
+    ok = table.index[table["status"] == "ok"]
+    table.loc[ok[:3], "quasi_static"] = False
+    rang = SweepSurrogate(targets=("max_deformation_cm",), n_restarts=0).fit(table)
+    assert f"rsj: 3 of {len(ok)} runs were not quasi-static (their push force rang" in " ".join(rang.notes_)
+    assert rang.domains_["rsj"].n_runs == len(ok)  # they train like the others
