@@ -59,14 +59,17 @@ def fit_predictor(tables: dict, held_out=(), replicates=None, targets=TARGETS, *
 def vouch(model: SweepSurrogate, rows, sweeps):
     """Store in ``model`` (in place) the coverage of its intervals on held-out runs: ``rows`` of the
     held-out table (``benchmarks/bench_predictor.py``: model, output, runs, coverage_95,
-    coverage_50), scored on the sweeps named ``sweeps``. Where they are stored they decide whether
-    the model prints that output's intervals (:func:`colonsim.surrogate.validation.error_unknown`);
-    the runs themselves are never fitted on."""
+    coverage_50), scored on ``sweeps``: their names, or name -> results table (each row then names
+    only the sweeps that hold runs of its model). Where they are stored they decide whether the
+    model prints that output's intervals (:func:`colonsim.surrogate.validation.error_unknown`); the
+    runs themselves are never fitted on."""
     model.held_out_ = {}
     for row in rows:
+        names = sorted(sweeps if not isinstance(sweeps, dict) else
+                       [name for name, table in sweeps.items() if (table["segment"] == row["model"]).any()])
         model.held_out_.setdefault(row["model"], {})[row["output"]] = {
             "runs": int(row["runs"]), "coverage_95": float(row["coverage_95"]),
-            "coverage_50": float(row["coverage_50"]), "sweeps": sorted(sweeps)}
+            "coverage_50": float(row["coverage_50"]), "sweeps": names}
     return model
 
 

@@ -260,6 +260,9 @@ def test_held_out_runs_decide_whether_intervals_are_printed(known, tmp_path):
     vouch(clean, held_out_rows(clean, held), ["synthetic_heldout"])
     why = clean.error_unknown("rsj", TARGET)
     assert why.startswith("its 95 % intervals covered ") and "of 40 held-out runs (synthetic_heldout)" in why
+    # given the tables, a model's verdict names only the held-out sweeps of its own runs
+    vouch(clean, held_out_rows(clean, held), {"synthetic_heldout": held, "rsf_heldout": held.assign(segment="rsf")})
+    assert "of 40 held-out runs (synthetic_heldout)" in clean.error_unknown("rsj", TARGET)
     few = SweepSurrogate(targets=(TARGET,), n_restarts=1).fit(known.iloc[:29])
     vouch(few, held_out_rows(few, held.iloc[:25]), ["synthetic_heldout"])
     assert few.error_unknown("rsj", TARGET).startswith("too few runs to know its error (29 < 10 per input")
