@@ -1,11 +1,12 @@
 """Fit the shipped pain predictor on the patient-space sweeps and store it as package data.
 
 The predictor is a :class:`SweepSurrogate` of the patient models (RSJ, RSF, THF) whose training
-sweeps it is given (presets ``patient_space_rsj``, ``_rsf``, ``_thf``), fitted on their results, with their tip-folded
-runs left out and counted, the noise floor of each output from the replicate sweeps
-(``_replicates``), and the reference wall (tissue stiffness 1) as the tissue of a query that names
-none. Its domain is each sweep's design range (:func:`design_domains`), where the runs reach it. Its JSON says what it is (``about``): the sweeps it was fitted on and those held
-out, the engine commits of the runs, the training domain of each model, the runs left out.
+sweeps it is given (presets ``patient_space_rsj``, ``_rsf``, ``_thf``), fitted on their results,
+with their tip-folded runs left out and counted, the noise floor of each output from the replicate
+sweeps (``_replicates``), and the reference wall (tissue stiffness 1) as the tissue of a query that
+names none. Its domain is each sweep's design range (:func:`design_domains`), where the runs reach
+it. Its JSON says what it is (``about``): the sweeps it was fitted on and those held out, the engine
+commits of the runs, the training domain of each model, the runs left out.
 """
 
 from __future__ import annotations
@@ -59,14 +60,13 @@ def fit_predictor(tables: dict, held_out=(), replicates=None, targets=TARGETS, *
 def vouch(model: SweepSurrogate, rows, sweeps):
     """Store in ``model`` (in place) the coverage of its intervals on held-out runs: ``rows`` of the
     held-out table (``benchmarks/bench_predictor.py``: model, output, runs, coverage_95,
-    coverage_50), scored on ``sweeps``: their names, or name -> results table (each row then names
-    only the sweeps that hold runs of its model). Where they are stored they decide whether the
+    coverage_50), scored on ``sweeps`` (name -> results table; each row names the sweeps that hold
+    runs of its model). Where they are stored they decide whether the
     model prints that output's intervals (:func:`colonsim.surrogate.validation.error_unknown`); the
     runs themselves are never fitted on."""
     model.held_out_ = {}
     for row in rows:
-        names = sorted(sweeps if not isinstance(sweeps, dict) else
-                       [name for name, table in sweeps.items() if (table["segment"] == row["model"]).any()])
+        names = sorted(name for name, table in sweeps.items() if (table["segment"] == row["model"]).any())
         model.held_out_.setdefault(row["model"], {})[row["output"]] = {
             "runs": int(row["runs"]), "coverage_95": float(row["coverage_95"]),
             "coverage_50": float(row["coverage_50"]), "sweeps": names}

@@ -24,10 +24,10 @@ shipped_only = pytest.mark.skipif(not predictor.shipped_exists() or not bench_pr
 def test_the_readme_quotes_the_committed_held_out_table_row_for_row():
     rows = json.loads(bench_predictor.RECORD.read_text(encoding="utf-8"))["rows"]
     table = [line for line in bench_predictor.format_table(rows).splitlines() if line.startswith("|")]
-    quoted = [line for line in README.splitlines() if line.startswith("| model | output | held-out runs")]
-    assert len(quoted) == 1, "the README quotes the held-out table once"
-    start = README.splitlines().index(quoted[0])
-    assert README.splitlines()[start:start + len(table)] == table
+    lines = README.splitlines()
+    starts = [i for i, line in enumerate(lines) if line.startswith("| model | output | held-out runs")]
+    assert len(starts) == 1, "the README quotes the held-out table once"
+    assert lines[starts[0]:starts[0] + len(table)] == table
 
 
 @shipped_only

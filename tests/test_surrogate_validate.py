@@ -83,6 +83,7 @@ def test_replicate_pairs_are_found_when_one_table_has_a_setting_the_other_lacks(
     found = replicate_scatter(successful_runs(train, "rsj"), reps, "rsj", inputs, TARGET)
     assert found["pairs"] == 12 and found["unpaired"] == 0
 
+
 def test_heldout_score_is_calibrated_with_the_right_noise(floored, test_table):
     s = score(floored, test_table, TARGET)
     assert s["n"] == 40 and s["n_train"] == 24
@@ -253,18 +254,18 @@ def test_held_out_runs_decide_whether_intervals_are_printed(known, tmp_path):
     held = rsj(40, seed=21)
     small = SweepSurrogate(targets=(TARGET,), n_restarts=1).fit(known.iloc[:29])
     assert small.error_unknown("rsj", TARGET).startswith("too few runs to know its error (29 < 10 per input")
-    vouch(small, held_out_rows(small, held), ["synthetic_heldout"])
+    vouch(small, held_out_rows(small, held), {"synthetic_heldout": held})
     assert small.error_unknown("rsj", TARGET) is None
     assert "held out: 40 runs, 95 % intervals covered" in small.report()
     clean = SweepSurrogate(targets=(TARGET,), n_restarts=1).fit(rsj(30, seed=11, noise=0.0))
-    vouch(clean, held_out_rows(clean, held), ["synthetic_heldout"])
+    vouch(clean, held_out_rows(clean, held), {"synthetic_heldout": held})
     why = clean.error_unknown("rsj", TARGET)
     assert why.startswith("its 95 % intervals covered ") and "of 40 held-out runs (synthetic_heldout)" in why
     # given the tables, a model's verdict names only the held-out sweeps of its own runs
     vouch(clean, held_out_rows(clean, held), {"synthetic_heldout": held, "rsf_heldout": held.assign(segment="rsf")})
     assert "of 40 held-out runs (synthetic_heldout)" in clean.error_unknown("rsj", TARGET)
     few = SweepSurrogate(targets=(TARGET,), n_restarts=1).fit(known.iloc[:29])
-    vouch(few, held_out_rows(few, held.iloc[:25]), ["synthetic_heldout"])
+    vouch(few, held_out_rows(few, held.iloc[:25]), {"synthetic_heldout": held.iloc[:25]})
     assert few.error_unknown("rsj", TARGET).startswith("too few runs to know its error (29 < 10 per input")
     json_path, _ = save_surrogate(small, tmp_path / "model")
     assert load_surrogate(json_path).error_unknown("rsj", TARGET) is None
