@@ -17,7 +17,7 @@ import pandas as pd
 import pytest
 
 from colonsim.insertion.case.scenario import InsertionCase, run_insertion
-from colonsim.insertion.study.sweep import IDENTITY, OUTPUTS, TABLE, SweepStore, result_row, run_sweep
+from colonsim.insertion.study.sweep import IDENTITY, OUTPUTS, TABLE, SweepStore, describe_cases, result_row, run_sweep
 from colonsim.insertion.study.sweep_outcomes import DIED, LocalPool, local_outcomes
 from colonsim.insertion.study.sweep_spec import load_sweep
 
@@ -286,3 +286,11 @@ def test_result_files_get_the_mode_of_a_plain_open(tmp_path):
     finally:
         os.umask(mask)
     assert (tmp_path / "a.json").stat().st_mode & 0o777 == (tmp_path / "b.json").stat().st_mode & 0o777 == 0o644
+
+
+def test_the_case_listing_shows_an_input_set_in_some_cases_and_unset_in_others():
+    """A material given in one case and not in the other varies (None is a value of its own)."""
+    cases = [types.SimpleNamespace(to_dict=lambda m=m: {"segment": "rsj", "material": m}, key=lambda m=m: f"k-{m}")
+             for m in (None, "tissue/material.json")]
+    header = describe_cases(cases).splitlines()[0].split()
+    assert header == ["key", "material"]

@@ -347,7 +347,8 @@ def read_results(folder) -> pd.DataFrame:
 def describe_cases(cases) -> str:
     """The cases as an aligned text table (inputs that vary, plus the key)."""
     frame = pd.DataFrame([{**c.to_dict(), "key": c.key()} for c in cases])
-    varying = [c for c in frame.columns if c != "key" and frame[c].astype(str).nunique() > 1]
+    # map(str), not astype(str): pandas 3 keeps None missing through astype(str), and nunique skips it
+    varying = [c for c in frame.columns if c != "key" and frame[c].map(str).nunique() > 1]
     return frame[["key", *varying]].to_string(index=False)
 
 
