@@ -168,6 +168,7 @@ class PrescribedVelocity(Constraint):
         if ramp < 0.0:
             raise ColonsimError(f"ramp = {ramp} s must be >= 0; fix it.")
         self.ramp = float(ramp)
+        self._targets = np.empty((len(self.nodes), 3))  # velocity_rows' targets, refilled every step
 
     def velocity(self, t):
         """Prescribed velocity at time t, m/s."""
@@ -186,9 +187,8 @@ class PrescribedVelocity(Constraint):
         return r.sum(axis=0)
 
     def velocity_rows(self, t_mid, state):
-        targets = np.empty((len(self.nodes), 3))
-        targets[:] = self.velocity(t_mid)
-        return self.nodes, HELD, targets
+        self._targets[:] = self.velocity(t_mid)
+        return self.nodes, HELD, self._targets
 
 
 class LineConstraint(Constraint):

@@ -144,7 +144,7 @@ class RodShellContact:
         self.friction_dissipated = 0.0
         self.n_active = 0
         self.normal_force = 0.0
-        self.force_on_rod = np.zeros(3)
+        self._force_on_rod = (0.0, 0.0, 0.0)
         self._p_damp = 0.0
         self._p_fric = 0.0
 
@@ -227,8 +227,13 @@ class RodShellContact:
         self._p_fric = p_fric
         self.n_active = n_active
         self.normal_force = normal
-        self.force_on_rod = np.array([f0, f1, f2])
+        self._force_on_rod = (f0, f1, f2)
         self._rod_weight = weight
+
+    @property
+    def force_on_rod(self):
+        """The contact's total force on the rod at the last evaluation, N (3,)."""
+        return np.array(self._force_on_rod)
 
     def finish_step(self, state, dt):
         """Accumulate the energy dissipated during the step: the forces of the step times the
@@ -249,7 +254,7 @@ class RodShellContact:
             "dissipated": self.dissipated,
             "friction_dissipated": self.friction_dissipated,
             "normal_force": self.normal_force,
-            "force_on_rod": self.force_on_rod.copy(),
+            "force_on_rod": self.force_on_rod,
             "n_active": self.n_active,
             "n_candidates": self.n_candidates,
         }

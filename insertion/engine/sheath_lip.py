@@ -71,6 +71,19 @@ def lip_kernel(x, v, f, point, direction, lip, stiffness, dashpot, out):
         prev = s
 
 
+@numba.njit(cache=True)
+def lip_dissipation(v, out):
+    """Twice the lip's mean dissipated power over a step, W: the power at the last evaluation
+    (``out`` of :func:`lip_kernel`) plus that of its damping force against the lip point's new
+    velocity (from ``v``). The segment of ``out`` must be >= 0."""
+    e = int(out[0])
+    t = out[1]
+    new = 0.0
+    for a in range(3):
+        new += out[6 + a] * ((1.0 - t) * v[e, a] + t * v[e + 1, a])
+    return out[9] - new
+
+
 class SheathLip:
     """Penalty support of a rod at the lip of a straight rigid sheath.
 
@@ -110,7 +123,6 @@ class SheathLip:
         self._dashpot = 2.0 * self.damping_ratio * math.sqrt(self.stiffness * m_min)
         self.energy = 0.0
         self.dissipated = 0.0
-        self.force = np.zeros(3)  # on the rod, N
         self._out = np.zeros(10)  # lip_kernel's results of the last evaluation
 
     def compute(self, state, dt):
@@ -118,17 +130,17 @@ class SheathLip:
         r = state[self.rod.name]
         lip_kernel(r.x, r.v, r.f_con, self.point, self.direction, self.lip, self.stiffness, self._dashpot, self._out)
         self.energy = float(self._out[2])
-        self.force = self._out[3:6].copy()
+
+    @property
+    def force(self):
+        """The lip's force on the rod at the last evaluation, N (3,)."""
+        return self._out[3:6].copy()
 
     def finish_step(self, state, dt):
         """Dissipation of the step: the damping force times the lip point's mean velocity."""
-        e = int(self._out[0])
-        if e < 0:
+        if self._out[0] < 0.0:
             return
-        r = state[self.rod.name]
-        t = self._out[1]
-        vp = (1.0 - t) * r.v[e] + t * r.v[e + 1]
-        self.dissipated += 0.5 * (self._out[9] - float(self._out[6:9] @ vp)) * dt
+        self.dissipated += 0.5 * lip_dissipation(state[self.rod.name].v, self._out) * dt
 
     def spring_action(self, state, u, ku):
         """Add K u of the lip's spring (across the axis, k / r^2 for its damping, as
@@ -146,7 +158,7 @@ class SheathLip:
         out[e + 1] += t * force
 
     def record(self):
-        return {"energy": self.energy, "dissipated": self.dissipated, "lip_force": self.force.copy()}
+        return {"energy": self.energy, "dissipated": self.dissipated, "lip_force": self.force}
 
     def follow_wall(self, body_omega2):
         """The sheath is rigid: nothing to follow."""

@@ -155,6 +155,10 @@ class ExplicitSolver:
         self._dt_prev = None
         self._fixed_key = None
         self._held_key = None
+        self._rest_key = None
+        self._rest_key_since = self._rest_key_until = -math.inf
+        self._rest_key_count = 0
+        self._per_body = None
         self._energy0 = None
         self._work_in = 0.0
 
@@ -203,8 +207,34 @@ class ExplicitSolver:
 
     # -- one step ---------------------------------------------------------------------------
 
+    def _holding_at_rest(self, t):
+        """Which constraints hold their nodes at rest at ``t`` (a tuple of flags, the solver's order).
+        The flags change only where a constraint's window starts or ends, so between two such times
+        the last tuple is returned without asking every constraint again (time only moves forward)."""
+        if self._rest_key is None or not self._rest_key_since <= t < self._rest_key_until:
+            self._rest_key = tuple(c.holds_at_rest and c.active(t) for c in self.constraints)
+            self._rest_key_since = t
+            bounds = [b for c in self.constraints if c.holds_at_rest for b in (c.start, c.end) if b > t]
+            self._rest_key_until = min(bounds, default=math.inf)
+            self._rest_key_count = len(self.constraints)
+        elif self._rest_key_count != len(self.constraints):  # a constraint added after construction
+            self._rest_key = None
+            return self._holding_at_rest(t)
+        return self._rest_key
+
+    def _by_body(self):
+        """Per body state: its constraints and resistances (in the solver's order), and whether
+        anything writes its external forces (loads, resistances); rebuilt when constraints are added."""
+        key = (len(self.constraints), len(self.loads), len(self.resistances))
+        if self._per_body is None or self._per_body[0] != key:
+            self._per_body = (key, [
+                (self.state[b.name], [c for c in self.constraints if c.body is b],
+                 [r for r in self.resistances if r.body is b],
+                 any(item.body is b for item in self.loads + self.resistances)) for b in self.bodies])
+        return self._per_body[1]
+
     def _refresh_fixed(self, t):
-        active = tuple(c.holds_at_rest and c.active(t) for c in self.constraints)
+        active = self._holding_at_rest(t)
         if active == self._fixed_key:
             return
         self._fixed_key = active
@@ -218,7 +248,7 @@ class ExplicitSolver:
         """Tell bodies that leave held elements out (a shell: :meth:`Shell.hold`) which of their
         nodes the constraints active at ``t`` hold, whenever that set changes (before the step's
         forces, so a node released at ``t`` gets its elements' forces from this step on)."""
-        key = tuple(c.holds_at_rest and c.active(t) for c in self.constraints)
+        key = self._holding_at_rest(t)
         if key == self._held_key:
             return
         self._held_key = key
@@ -247,12 +277,14 @@ class ExplicitSolver:
         dt_mid = dt if self._dt_prev is None else 0.5 * (dt + self._dt_prev)
         t = self.time
         self._hold_elements(t)
+        bodies = self._by_body()
         try:
-            for s in self.state.values():
+            for s, _, _, written in bodies:
                 s.f_int[:] = 0.0
                 s.internal = s.body.internal_forces(s.x, s.f_int)
                 s.f_con[:] = 0.0
-                s.f_ext[:] = 0.0
+                if written:  # nothing else writes f_ext: it stays zero
+                    s.f_ext[:] = 0.0
             for c in self.contacts:
                 c.compute(self.state, dt_mid)
         except ColonsimError as err:
@@ -263,11 +295,9 @@ class ExplicitSolver:
         self._refresh_fixed(t)
         energy = 0.0
         work_in = 0.0
-        for b in self.bodies:
-            s = self.state[b.name]
+        for s, constraints, resistances, _ in bodies:
             w_int, w_con, w_ext, w_damp, w_react, kinetic = step_body(
-                s, [c for c in self.constraints if c.body is b], self.damping[b.name], t, t + 0.5 * dt, dt_mid, dt,
-                [r for r in self.resistances if r.body is b])
+                s, constraints, self.damping[s.body.name], t, t + 0.5 * dt, dt_mid, dt, resistances)
             s.kinetic = kinetic
             s.work_internal += w_int
             s.work_contact += w_con
