@@ -101,6 +101,8 @@ COLUMNS = {c.name: c for c in (
                                         "the resistance engages)"),
     Column("held_push_pace", _S, "", "tip pace (advance over push) at which the held push returns to the push speed "
                                      "(0: never)"),
+    Column("straighten_speed_factor", _S, "", "RSF/THF: speed of the straightening push as a multiple of the push "
+                                              "speed"),
     Column("ramp_s", _S, "s", "speed-change ramp"),
     Column("relax_s", _S, "s", "relax pause of straighten-relax-push (the constraint fades over it)"),
     Column("relax_max_s", _S, "s", "longest relax: it goes on until the released system is at rest (0: relax_s)"),

@@ -104,7 +104,7 @@ def test_zero_resistance_builds_no_resistance_and_keeps_the_key_of_before():
                                      "held_push_lead_mm", "relax_max_s",
                                      "centerline", "centerline_smoothing_mm", "material_parameters",
                                      "time_step_estimate", "contact_surface", "contact_face_subdivision",
-                                     "stiffness_factor", "held_push_pace")
+                                     "stiffness_factor", "held_push_pace", "straighten_speed_factor")
     assert InsertionCase(distal_resistance_N=5.0).key() != InsertionCase(distal_resistance_N=0.0).key()
 
 
@@ -147,7 +147,8 @@ def test_a_held_push_lead_enters_the_key_only_where_a_resistance_holds_the_tip()
     assert before.key() == key_without(before, "held_push_lead_mm", "relax_max_s",  # no relax in the RSJ
                                        "centerline", "centerline_smoothing_mm", "material_parameters",
                                        "failure_stretch", "time_step_estimate", "contact_surface",
-                                       "contact_face_subdivision", "stiffness_factor", "held_push_pace")
+                                       "contact_face_subdivision", "stiffness_factor", "held_push_pace",
+                                       "straighten_speed_factor")
     # nothing holds the tip: the lead does nothing and stays out
     free = InsertionCase(distal_resistance_N=0.0)
     assert InsertionCase(distal_resistance_N=0.0, held_push_lead_mm=0.0).key() == free.key()

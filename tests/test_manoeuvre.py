@@ -165,3 +165,30 @@ def test_only_a_pause_is_retimed():
     assert not p.retime("push", p.duration + 1.0)  # a moving phase
     assert not p.retime(RELAX, p.phases[2].start - 0.01)  # before its own start
     assert not continuous_push(0.2).retime(RELAX, 1.0)  # no relax
+
+
+def test_a_faster_straightening_reaches_the_same_depths_sooner_and_the_final_push_keeps_its_speed():
+    """``straighten_speed``: only the straightening push changes; it still comes to rest at the
+    straightening depth, the final push runs at ``speed`` to the same total depth."""
+    slow = straighten_relax_push(0.239, 0.68, speed=0.15, ramp=0.4, relax=0.1)
+    fast = straighten_relax_push(0.239, 0.68, speed=0.15, ramp=0.4, relax=0.1, straighten_speed=0.3)
+    assert fast.phases[0].speed == 0.3 and fast.phases[-1].speed == slow.phases[-1].speed == 0.15
+    # 3 cm of speed ramp each way at 0.15 m/s, 6 cm at 0.3 m/s: the plateaus take 1.195 s and 0.397 s
+    assert slow.phases[0].end - fast.phases[0].end == pytest.approx(0.179 / 0.15 - 0.119 / 0.3, rel=1e-9)
+    for p in (slow, fast):
+        assert p.depth(p.lateral_constraint_end) == pytest.approx(0.239, rel=1e-12)
+        assert p.depth(p.duration) == pytest.approx(0.68, rel=1e-12)
+        assert _integrated_depth(p, p.duration) == pytest.approx(0.68, rel=1e-6)
+    assert fast.duration == pytest.approx(slow.duration - (slow.phases[0].end - fast.phases[0].end), rel=1e-12)
+    with pytest.raises(ColonsimError, match="push speed"):
+        straighten_relax_push(0.239, 0.68, speed=0.15, straighten_speed=0.0)
+
+
+def test_the_straightening_speed_is_a_setting_of_the_models_that_straighten_only():
+    from colonsim.insertion.case.insertion_case import InsertionCase
+
+    assert InsertionCase(segment="rsf", straighten_speed_factor=1.0).key() == InsertionCase(segment="rsf").key()
+    assert InsertionCase(segment="thf", straighten_speed_factor=2.0).key() != InsertionCase(segment="thf").key()
+    assert InsertionCase(segment="rsj", straighten_speed_factor=2.0).key() == InsertionCase(segment="rsj").key()
+    with pytest.raises(ColonsimError, match="straighten_speed_factor"):
+        InsertionCase(segment="rsf", straighten_speed_factor=0.5).validate()

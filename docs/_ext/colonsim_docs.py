@@ -45,6 +45,7 @@ PARAMETERS = {
     "held_push_share": ("", NUMERICAL),
     "held_push_lead_mm": ("mm", NUMERICAL),
     "held_push_pace": ("", NUMERICAL),
+    "straighten_speed_factor": ("", NUMERICAL),
     "ramp_s": ("s", NUMERICAL),
     "relax_s": ("s", NUMERICAL),
     "relax_max_s": ("s", NUMERICAL),

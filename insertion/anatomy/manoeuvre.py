@@ -285,24 +285,27 @@ def continuous_push(depth, speed=0.6, ramp=0.05, stop_distance=0.0, settle=0.0) 
 
 
 def straighten_relax_push(straighten_depth, depth, speed=0.6, ramp=0.05, relax=0.1, stop_distance=0.0,
-                          settle=0.0) -> PushProfile:
-    """RSF/THF: push to ``straighten_depth`` with the lateral constraint, slow to a stop there with
-    it still on, relax for ``relax`` seconds with it released, then push on to ``depth`` (m)
-    (coming to rest there and holding, as :func:`continuous_push`).
+                          settle=0.0, straighten_speed=None) -> PushProfile:
+    """RSF/THF: push to ``straighten_depth`` with the lateral constraint (at ``straighten_speed``,
+    m/s; None: ``speed``), slow to a stop there with it still on, relax for ``relax`` seconds with
+    it released, then push on to ``depth`` (m) at ``speed`` (coming to rest there and holding, as
+    :func:`continuous_push`).
 
     Phases: ``straighten`` (at speed) and ``stop`` (the slow-down ramp, ending at rest at
     ``straighten_depth``) hold the mobile part (``lateral_constraint``); ``relax`` and ``push`` do not.
     """
     _check(depth, speed, ramp)
+    straighten_speed = speed if straighten_speed is None else straighten_speed
+    _check(depth, straighten_speed, ramp)
     if not 0.0 < straighten_depth < depth:
         raise ColonsimError(f"straightening depth {straighten_depth:.3g} m must lie between 0 and the total depth {depth:.3g} m")
     if not (np.isfinite(relax) and relax > 0.0):
         raise ColonsimError(f"relax time {relax!r} s must be positive (the scope must come to rest)")
-    t1 = _time_to_stop_at(straighten_depth, speed, ramp)
+    t1 = _time_to_stop_at(straighten_depth, straighten_speed, ramp)
     t2 = t1 + ramp
     t3 = t2 + relax
     t4 = t3 + _time_to_push(depth - straighten_depth, speed, ramp)
-    phases = [Phase("straighten", 0.0, t1, speed, lateral_constraint=True),
+    phases = [Phase("straighten", 0.0, t1, straighten_speed, lateral_constraint=True),
               Phase("stop", t1, t2, 0.0, lateral_constraint=True),
               Phase(RELAX, t2, t3, 0.0),
               Phase("push", t3, t4, speed)]

@@ -29,7 +29,7 @@ TIME_STEP_ESTIMATES = ("bounds", "global")
 # fields left out of the key at the value that gives the runs of before they existed
 # (a default changed to another value then gives new keys: no run of before is taken for one of it)
 ABSENT_AT = {"distal_resistance_N": 0.0, "held_push_share": 1.0, "held_push_lead_mm": 0.0, "held_push_pace": 0.0,
-             "relax_max_s": 0.0,
+             "relax_max_s": 0.0, "straighten_speed_factor": 1.0,
              "time_step_estimate": "bounds", "contact_surface": "nodes", "stiffness_factor": 1.0}
 
 
@@ -98,6 +98,10 @@ class InsertionCase:
         pace falls :data:`~colonsim.insertion.case.held_push.PACE_HYSTERESIS` below.
     sheath_reserve_mm : float
         Scope length that stays in the sheath at the end of the push (**assumption** 20).
+    straighten_speed_factor : float
+        RSF/THF: the straightening push (the mobile part held to its axis) at this multiple of
+        ``push_speed`` (1: the same speed; docs/model.md, "Loading"). The system comes to rest
+        after it (``relax_max_s``), so the final push starts from the same equilibrium.
     ramp_s, relax_s : float
         Speed-change ramp and the relax pause of RSF/THF, s (the straightening constraint fades
         over ``relax_s``).
@@ -161,6 +165,7 @@ class InsertionCase:
     held_push_share: float = 0.5
     held_push_lead_mm: float = 50.0
     held_push_pace: float = 0.0
+    straighten_speed_factor: float = 1.0
     ramp_s: float = 0.4
     relax_s: float = 0.1
     relax_max_s: float = 5.0
@@ -207,6 +212,8 @@ class InsertionCase:
              f"distance before the fixed exit at which the held push begins, mm ({InsertionCase.held_push_lead_mm:g})"),
             ("held_push_pace", self.held_push_pace, 0.0, 1.0,
              "share of the push the tip must keep for the held push to return to the push speed (0: never)"),
+            ("straighten_speed_factor", self.straighten_speed_factor, 1.0, 4.0,
+             f"speed of the straightening push as a multiple of push_speed ({InsertionCase.straighten_speed_factor:g})"),
             ("colon_damping", self.colon_damping, 0.0, 1e4, "damping in 1/s"),
             ("scope_damping", self.scope_damping, 0.0, 1e4, "damping in 1/s"),
             ("scope_lateral_damping", self.scope_lateral_damping, 0.0, 1e4, "damping in 1/s"),
@@ -288,8 +295,9 @@ class InsertionCase:
             if inputs[name] == value:
                 del inputs[name]
         model = COLON_MODELS.get(self.segment)
-        if model is not None and not model.straightens:  # no relax: its bound does nothing
+        if model is not None and not model.straightens:  # no relax nor straightening: their settings do nothing
             inputs.pop("relax_max_s", None)
+            inputs.pop("straighten_speed_factor", None)
         if "contact_surface" not in inputs:  # the wall's nodes: no face points to subdivide
             inputs.pop("contact_face_subdivision", None)
         if "distal_resistance_N" not in inputs:  # nothing holds the tip: the held push never starts

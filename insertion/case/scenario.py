@@ -159,7 +159,7 @@ def build_insertion(case: InsertionCase) -> Insertion:
         push = continuous_push(total_depth, case.push_speed, case.ramp_s, *stop)
     else:
         push = straighten_relax_push(geometry.straighten_depth, total_depth, case.push_speed, case.ramp_s,
-                                     case.relax_s, *stop)
+                                     case.relax_s, *stop, straighten_speed=case.push_speed * case.straighten_speed_factor)
 
     # tube meshes are oriented with normals out of the lumen: the fixed wall's rest normals
     contact = RodShellContact(rod, shell, friction=case.friction,
