@@ -1,10 +1,11 @@
 """A faster straightening push in RSF and THF: what it saves and what it moves, from one sweep.
 
     python benchmarks/bench_straighten.py DIR/straighten_speed
+    python benchmarks/bench_straighten.py benchmarks/records/straighten_speed   # the runs of 2026-12-07
 
-Reads a sweep of ``benchmarks/sweeps/straighten_speed.toml`` (each case with
+Reads a sweep (or its record) of ``benchmarks/sweeps/straighten_speed.toml`` (each case with
 ``straighten_speed_factor`` 1, 2 and 3) and prints, per case and factor above 1, the steps the run
-took against the same case at factor 1 (counted from each run's ``timeseries.csv``; the push sets
+took against the same case at factor 1 (each run's ``summary.json``; the push sets
 the step count, so this is the saving at an unchanged cost per step), the wall time ratio (a
 shared machine disturbs it), the ringing ratio and snap-throughs of both, and the rate check's
 outputs as departures from factor 1 against the rate check's bounds (the report's
@@ -16,6 +17,7 @@ straightening should leave the final push's start, and every answer, where they 
 from __future__ import annotations
 
 import argparse
+import json
 import sys
 from pathlib import Path
 
@@ -29,9 +31,8 @@ FACTOR = "straighten_speed_factor"
 
 
 def steps_of(folder: Path, row) -> int:
-    """Time steps of one run: the last ``step`` of its time series."""
-    series = pd.read_csv(folder / row["timeseries_path"], usecols=["step"])
-    return int(series["step"].iloc[-1])
+    """Time steps of one run, from its ``summary.json`` (a sweep folder or a packed record)."""
+    return int(json.loads((folder / row["timeseries_path"]).with_name("summary.json").read_text())["steps"])
 
 
 def compare(folder: Path) -> tuple[list, int]:
