@@ -97,8 +97,7 @@ def key_without(case, *names):
 
 def test_zero_resistance_builds_no_resistance_and_keeps_the_key_of_before():
     case = InsertionCase(segment="rsf", angle_deg=45.0, element_size_mm=COARSE_MM, distal_resistance_N=0.0,
-                         relax_max_s=0.0, time_step_estimate="bounds",  # the relax, the time step and
-                         straighten_speed_factor=1.0)  # the straightening of before
+                         relax_max_s=0.0, time_step_estimate="bounds")  # the relax and the time step of before
     assert build_insertion(case).resistance is None
     # the runs of before lacked the first five and the last; the three between stay out at their defaults
     assert case.key() == key_without(case, "distal_resistance_N", "failure_stretch", "held_push_share",

@@ -187,10 +187,9 @@ def test_a_faster_straightening_reaches_the_same_depths_sooner_and_the_final_pus
 def test_the_straightening_speed_is_a_setting_of_the_models_that_straighten_only():
     from colonsim.insertion.case.insertion_case import InsertionCase
 
-    # twice the push speed by default; at 1, the runs of before, it stays out of the key
-    assert InsertionCase().straighten_speed_factor == 2.0
-    before = InsertionCase(segment="rsf", straighten_speed_factor=1.0)
-    assert before.key() != InsertionCase(segment="rsf").key()
-    assert InsertionCase(segment="rsj", straighten_speed_factor=1.0).key() == InsertionCase(segment="rsj").key()
+    # at 1, the default and the runs of before, it stays out of the key
+    assert InsertionCase(segment="rsf", straighten_speed_factor=1.0).key() == InsertionCase(segment="rsf").key()
+    assert InsertionCase(segment="thf", straighten_speed_factor=2.0).key() != InsertionCase(segment="thf").key()
+    assert InsertionCase(segment="rsj", straighten_speed_factor=2.0).key() == InsertionCase(segment="rsj").key()
     with pytest.raises(ColonsimError, match="straighten_speed_factor"):
         InsertionCase(segment="rsf", straighten_speed_factor=0.5).validate()
