@@ -89,3 +89,19 @@ def test_threaded_nodal_updates_match_serial(two_threads):
         results.append((sim.state["scope"].x.copy(), hist.bodies["scope"]["kinetic"][-1]))
     assert np.array_equal(results[0][0], results[1][0])
     assert results[0][1] == pytest.approx(results[1][1], rel=1e-12)
+
+
+def test_a_constraint_born_and_dying_holds_its_nodes_exactly_over_its_window():
+    # The solver asks the constraints' windows again only where one starts or ends: a hold born at
+    # 1 ms and dying at 2 ms keeps its nodes still exactly over that window and not outside it.
+    rod = Rod.straight(0.1, D, E, RHO, spacing=5e-3)
+    hold = FixedNodes(rod, [rod.tip_node], start=1e-3, end=2e-3)
+    sim = ExplicitSolver([rod], constraints=[hold], loads=[NodalLoad(rod, [rod.tip_node], (2.0, 0.0, 0.0))])
+    tips = []
+    while sim.time < 3e-3:
+        sim.advance()
+        tips.append((sim.time, sim.state["scope"].x[rod.tip_node, 0]))
+    t, x = np.array(tips).T
+    held = (t > 1e-3 + sim.dt) & (t < 2e-3)  # from the first step that starts inside the window
+    assert np.ptp(x[held]) == 0.0 and held.sum() > 5
+    assert np.all(np.diff(x[t < 1e-3]) > 0.0) and np.all(np.diff(x[t > 2e-3 + sim.dt]) > 0.0)
