@@ -155,8 +155,8 @@ class ExplicitSolver:
         self._dt_prev = None
         self._fixed_key = None
         self._held_key = None
-        self._rest_key = None
-        self._rest_key_since = self._rest_key_until = -math.inf
+        self._rest_key = ()
+        self._rest_key_since = self._rest_key_until = -math.inf  # an empty window: asked at the first step
         self._rest_key_count = 0
         self._per_body = None
         self._energy0 = None
@@ -211,15 +211,13 @@ class ExplicitSolver:
         """Which constraints hold their nodes at rest at ``t`` (a tuple of flags, the solver's order).
         The flags change only where a constraint's window starts or ends, so between two such times
         the last tuple is returned without asking every constraint again (time only moves forward)."""
-        if self._rest_key is None or not self._rest_key_since <= t < self._rest_key_until:
+        added = self._rest_key_count != len(self.constraints)  # a constraint added after construction
+        if added or not self._rest_key_since <= t < self._rest_key_until:
             self._rest_key = tuple(c.holds_at_rest and c.active(t) for c in self.constraints)
             self._rest_key_since = t
             bounds = [b for c in self.constraints if c.holds_at_rest for b in (c.start, c.end) if b > t]
             self._rest_key_until = min(bounds, default=math.inf)
             self._rest_key_count = len(self.constraints)
-        elif self._rest_key_count != len(self.constraints):  # a constraint added after construction
-            self._rest_key = None
-            return self._holding_at_rest(t)
         return self._rest_key
 
     def _by_body(self):
