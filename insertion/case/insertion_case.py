@@ -102,8 +102,7 @@ class InsertionCase:
         RSF/THF: the straightening push (the mobile part held to its axis) at this multiple of
         ``push_speed`` (1: the same speed, the default; docs/model.md, "Loading"). The system comes
         to rest after it (``relax_max_s``), so the final push starts from the same equilibrium; 2
-        is measured to move no output of the rate check by more than 0.4 % (9-15 % fewer steps)
-        and becomes the default when the validation report's records are rerun.
+        moves no output of the rate check by more than 0.4 % (9-15 % fewer steps).
     ramp_s, relax_s : float
         Speed-change ramp and the relax pause of RSF/THF, s (the straightening constraint fades
         over ``relax_s``).
