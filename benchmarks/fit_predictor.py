@@ -4,7 +4,7 @@
     python benchmarks/fit_predictor.py --train /work/runs/patient_space_rsj /work/runs/patient_space_rsf ...
 
 Reads the training sweeps' ``results.parquet`` (default: ``benchmarks/records/patient_space_{rsj,rsf,thf}``
-and ``patient_space_thf_more``, THF's second hypercube) and their replicate pairs (``..._replicates``, the noise floor),
+and THF's further hypercubes ``patient_space_thf_more``, ``_more2``) and their replicate pairs (``..._replicates``, the noise floor),
 fits :func:`colonsim.surrogate.predictor_fit.fit_predictor` (tip-folded runs left out and counted),
 scores it on the held-out sweeps (``..._heldout``, never fitted on) and stores their coverage in the
 model, where it decides which outputs print intervals
@@ -22,7 +22,7 @@ from pathlib import Path
 import pandas as pd
 
 from colonsim.errors import ColonsimError
-from colonsim.insertion.study.sweep_presets import patient_space_name
+from colonsim.insertion.study.sweep_presets import more_parts, patient_space_name
 from colonsim.surrogate.predictor import SHIPPED
 from colonsim.surrogate.predictor_fit import PATIENT_MODELS, fit_predictor, save_predictor, vouch
 from colonsim.surrogate.table import read_results
@@ -40,10 +40,11 @@ def _tables(paths) -> dict:
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--train", type=Path, nargs="+",
-                        default=[p for m in PATIENT_MODELS for part in ("", "more")
+                        default=[p for m in PATIENT_MODELS for part in ("", *more_parts(m))
                                  if (p := RECORDS / patient_space_name(m, part)).exists()],
                         help="training sweep folders (or results tables) of the patient models (default: the "
-                             "committed records there are, patient_space_MODEL and patient_space_MODEL_more)")
+                             "committed records there are, patient_space_MODEL and its further hypercubes, "
+                             "patient_space_MODEL_more, _more2)")
     parser.add_argument("--replicates", type=Path, nargs="*",
                         default=[p for m in PATIENT_MODELS if (p := RECORDS / f"patient_space_{m}_replicates").exists()],
                         help="replicate sweep folders (or tables): cases at two wall meshes, the noise floor")

@@ -141,10 +141,10 @@ def test_the_patient_space_presets_parse_into_cases():
     assert {round(c.stiffness_factor, 3) for c in spec.cases} <= {round(v, 3) for v in np.arange(0.6, 1.6005, 0.001)}
 
 
-def test_one_preset_runs_the_predictors_ten_sweeps_each_into_its_folder(tmp_path, capsys):
+def test_one_preset_runs_the_predictors_eleven_sweeps_each_into_its_folder(tmp_path, capsys):
     assert main(["sweep", "--preset", "patient_space", "--dry-run", "--out", str(tmp_path / "ps")]) == 0
     lines = [line for line in capsys.readouterr().out.splitlines() if line.startswith("sweep patient_space")]
-    assert len(lines) == 10 and sum(int(line.split(": ")[1].split()[0]) for line in lines) == 426
+    assert len(lines) == 11 and sum(int(line.split(": ")[1].split()[0]) for line in lines) == 498
     assert f"0 already in {tmp_path / 'ps' / 'patient_space_thf_replicates'}/" in lines[-1]
     assert main(["sweep", "--preset", "patient_space", "--adaptive", "--budget", "5"]) == 2
     assert "--adaptive takes one sweep" in capsys.readouterr().err

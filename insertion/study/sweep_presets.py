@@ -33,10 +33,16 @@ PATIENT_MODELS = {  # model -> (inputs it varies, its own ranges, training runs,
 # the other parts of each model's sweep: runs and seed offset (added to the training seed)
 PATIENT_PARTS = {"heldout": (30, 100), "replicates": (10, 200)}
 # More training runs where one hypercube leaves the response unresolved: model -> (runs, seed offset)
-# of a second, independent Latin hypercube over the training ranges (part "more"). THF's 72 runs
-# predicted its held-out runs with an RMSE of half its spread and intervals too narrow (its loops
-# snap through at some angles and not at others), docs/surrogate.md "How well it predicts".
-PATIENT_MORE = {"thf": (72, 300)}
+# of each further, independent Latin hypercube over the training ranges (parts "more", "more2", ...).
+# THF's 72 runs predicted its held-out runs with an RMSE of half its spread and intervals too narrow
+# (its loops snap through at some angles and not at others), and 144 still too narrow,
+# docs/surrogate.md "How well it predicts".
+PATIENT_MORE = {"thf": ((72, 300), (72, 400))}
+
+
+def more_parts(model: str) -> tuple:
+    """The part names of ``model``'s further training hypercubes: "more", "more2", ..."""
+    return tuple("more" + (str(i + 1) if i else "") for i in range(len(PATIENT_MORE.get(model, ()))))
 REPLICATE_MESHES_MM = (3.0, 2.8)
 
 
@@ -47,7 +53,7 @@ def patient_space_name(model: str, part: str = "") -> str:
 
 def patient_space(model: str, part: str = "") -> str:
     """The TOML of the patient-space sweep of ``model``: its training runs (``part`` ""), more of
-    them ("more", a second hypercube: :data:`PATIENT_MORE`), its held-out runs ("heldout") or its
+    them ("more", "more2": further hypercubes, :data:`PATIENT_MORE`), its held-out runs ("heldout") or its
     replicate pairs ("replicates").
 
     The held-out and replicate hypercubes span each range less one training stratum (range /
@@ -58,10 +64,11 @@ def patient_space(model: str, part: str = "") -> str:
     ranges = {name: own.get(name, PATIENT_RANGES[name]) for name in inputs}
     grid = [f'segment = "{model}"']
     what = "training runs of the shipped predictor"
-    if part == "more":
-        runs, offset = PATIENT_MORE[model]
+    if part in more_parts(model):
+        index = more_parts(model).index(part)
+        runs, offset = PATIENT_MORE[model][index]
         seed += offset
-        what = "more training runs of the shipped predictor (a second hypercube)"
+        what = f"more training runs of the shipped predictor (a {('second', 'third', 'fourth')[index]} hypercube)"
     elif part:
         ranges = {n: (math.ceil(1e3 * (lo + (hi - lo) / runs)) / 1e3, math.floor(1e3 * (hi - (hi - lo) / runs)) / 1e3)
                   for n, (lo, hi) in ranges.items()}  # rounded inwards, to the hypercube's 3 decimals
@@ -209,7 +216,7 @@ friction = [0.05]
 """,
 }
 PATIENT_SPACE = tuple((m, part) for m in PATIENT_MODELS  # training runs first
-                      for part in ("", *(("more",) if m in PATIENT_MORE else ()), *PATIENT_PARTS))
+                      for part in ("", *more_parts(m), *PATIENT_PARTS))
 PRESETS.update({patient_space_name(m, part): patient_space(m, part) for m, part in PATIENT_SPACE})
 # Presets run together by one name (``colonsim sweep --preset NAME``: each into its own folder
 # under --out, in this order): the shipped predictor's sweep, training runs first.
