@@ -25,7 +25,7 @@ TIMED = ("sdc", 36.0)
 # where a run's time goes: each function's own time (the profiler's tottime) goes to the first
 # job whose name fragment its "file:function" holds; the rest is Python around the kernels
 JOBS = {
-    "wall internal forces (compiled)": ("shell_forces.py:internal_forces_kernel",),
+    "wall internal forces (compiled)": ("shell_forces.py:_blocked_", "shell_forces.py:elementwise_forces_kernel"),
     "wall and scope nodal updates (compiled)": ("integrator_kernels.py",),
     "scope's implicit update (compiled)": ("rod_damping.py:damped_rod_velocity",),
     "scope's internal forces (compiled)": ("rod.py:rod_kernel",),

@@ -195,7 +195,7 @@ def element_costs(colon, x, repeat=15, calls=20):
     """Median seconds per triangle and per hinge of the wall's membrane and hinge passes, for the
     element-by-element kernel and the blocked one, timed alternately in this process (CPU time,
     which a shared machine disturbs less than wall time) at the positions ``x``."""
-    from colonsim.insertion.engine.shell_forces import internal_forces_kernel, triangle_reference
+    from colonsim.insertion.engine.shell_forces import internal_forces, triangle_reference
 
     tri, hinges, stiffness, theta0 = colon.triangles, colon.hinges, colon.hinge_stiffness, colon.theta0
     ref = triangle_reference(colon.dm_inv, colon.area0, colon.thickness)
@@ -205,8 +205,8 @@ def element_costs(colon, x, repeat=15, calls=20):
 
     def structure(blocked):
         def call(nt, nh):
-            internal_forces_kernel(x, tri[:nt], ref[:, :nt], colon._law, colon._law_params, hinges[:nh],
-                                   stiffness[:nh], theta0[:nh], out, False, energy, count, blocked)
+            internal_forces(x, tri[:nt], ref[:, :nt], colon._law, colon._law_params, hinges[:nh], stiffness[:nh],
+                            theta0[:nh], out, False, energy, count, blocked)
         return call
 
     passes = {"membrane": (len(tri), 0), "hinges": (0, len(hinges))}

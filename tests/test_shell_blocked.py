@@ -1,5 +1,6 @@
-"""The blocked internal-force kernel gives the element-by-element kernel's forces and energies on
-a randomly deformed mesh, for every wall law, on one and two threads, with held elements left out."""
+"""The blocked internal-force kernels (one per wall law) give the element-by-element kernel's forces
+and energies on a randomly deformed mesh, for every wall law, on one and two threads, with held
+elements left out."""
 
 import numpy as np
 import pytest
@@ -93,3 +94,10 @@ def test_unknown_force_kernel_is_one_line(serial_kernels):
     tube, x, _ = deformed_tube(MATERIALS["reference"])
     with pytest.raises(ColonsimError, match="use 'blocked' or 'elementwise'"):
         forces(tube, x, "vectorised")
+
+
+def test_a_law_index_without_a_blocked_kernel_is_refused(serial_kernels):
+    tube, x, _ = deformed_tube(MATERIALS["reference"])
+    tube._law = 99  # each law has a blocked kernel of its own (shell_forces.BLOCKED_KERNELS)
+    with pytest.raises(ValueError, match="no wall law has the index 99"):
+        forces(tube, x, "blocked")

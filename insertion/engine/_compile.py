@@ -1,4 +1,4 @@
-"""Compile one kernel source two ways: threaded and serial.
+"""Compile one kernel source several ways: threaded and serial, or once per value of a constant.
 
 Bodies and candidate lists below a size threshold run serially (starting threads costs more than
 their work, and much more on a loaded machine), larger ones on threads. Both variants come from
@@ -7,7 +7,8 @@ by compile options: the same function jitted with ``parallel=True`` and without 
 entry, and a process then loads the other variant's machine code (checked: the serial dispatcher
 reported a cache hit on the entry the threaded one wrote). The serial variant is therefore
 compiled from a copy of the function whose qualified name ends in ``_serial``: one source, two
-cache entries.
+cache entries. A kernel specialised to a constant (one per wall law, say) is made the same way:
+a copy per value, whose globals bind the constant, under a qualified name of its own.
 """
 
 import types
@@ -23,3 +24,14 @@ def threaded_and_serial(py_func):
     serial.__qualname__ = py_func.__qualname__ + "_serial"
     serial.__doc__ = py_func.__doc__
     return numba.njit(parallel=True, cache=True)(py_func), numba.njit(cache=True)(serial)
+
+
+def with_constant(py_func, suffix, **constants):
+    """A copy of ``py_func`` whose module globals also bind ``constants`` (which Numba freezes
+    into the machine code), named ``py_func``'s name + ``suffix`` so that each copy has its own
+    cache entry; jit it as the original would be."""
+    copy = types.FunctionType(py_func.__code__, {**py_func.__globals__, **constants}, py_func.__name__ + suffix,
+                              py_func.__defaults__, py_func.__closure__)
+    copy.__qualname__ = py_func.__qualname__ + suffix
+    copy.__doc__ = py_func.__doc__
+    return copy

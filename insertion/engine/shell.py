@@ -24,7 +24,7 @@ import numpy as np
 from colonsim.errors import ColonsimError
 from colonsim.insertion.engine._scatter import gather, node_incidence
 from colonsim.insertion.engine.sheet_mesh import hinges as mesh_hinges
-from colonsim.insertion.engine.shell_forces import internal_forces_kernel, triangle_reference
+from colonsim.insertion.engine.shell_forces import internal_forces, triangle_reference
 from colonsim.insertion.engine.shell_hinges import (bending_stiffness, dihedral_angles, hinge_rowsum_kernel,
                                                     hinge_stiffness, max_row_over_mass)
 from colonsim.insertion.engine.shell_membrane import check_dispatched, membrane_omega2_kernel, reference_frames
@@ -237,9 +237,8 @@ class Shell:
         if self.force_kernel not in ("blocked", "elementwise"):
             raise ColonsimError(f"Shell.force_kernel = {self.force_kernel!r}: use 'blocked' or 'elementwise'.")
         tri, _, _, hinges, hinge_stiffness, theta0 = self._active  # the elements not all held
-        internal_forces_kernel(x, tri, self._active_reference, self._law, self._law_params, hinges, hinge_stiffness,
-                               theta0, out, not direct, self._chunk_energy, self._chunk_count,
-                               self.force_kernel == "blocked")
+        internal_forces(x, tri, self._active_reference, self._law, self._law_params, hinges, hinge_stiffness, theta0,
+                        out, not direct, self._chunk_energy, self._chunk_count, self.force_kernel == "blocked")
         n_inv, n_bad = self._chunk_count.sum(axis=0) if self._chunk_count.any() else (0, 0)
         if n_inv:
             raise ColonsimError(

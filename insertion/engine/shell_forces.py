@@ -1,7 +1,7 @@
 """The wall's internal forces: membrane and hinges in one parallel pass, in either of two loop
 structures that do the same arithmetic.
 
-:func:`internal_forces_kernel` splits the elements into one contiguous chunk per thread; chunk
+:func:`internal_forces` splits the elements into one contiguous chunk per thread; chunk
 ``c`` adds the forces of its triangles and hinges into its own nodal array ``out[c]``, so no two
 threads write the same memory (with one chunk ``out`` can be a view of the force array itself).
 Within a chunk the elements go
@@ -15,8 +15,9 @@ Within a chunk the elements go
   (straight-line arithmetic on those arrays and the per-element reference quantities, with no
   indirect access) runs several elements at once in the vector registers, and the scatter adds
   the results onto the nodes (a hinge's forces, a few products of its angle and gradients, are
-  formed there: 6 % faster than in a vector loop of their own). The law is chosen once per block, so each law's compute loop is
-  compiled apart with its branch folded away.
+  formed there: 6 % faster than in a vector loop of their own). Each law has a blocked kernel of
+  its own (:data:`BLOCKED_KERNELS`), which holds that law's compute loop alone with its branches
+  folded away, and compiles on its first call.
 
 Each element goes through the same operations in both, and its forces are added onto the nodes in
 the same order, so the two give the same forces and energies to the last bit
@@ -30,17 +31,15 @@ import math
 
 import numba
 import numpy as np
+from numba.core import types
+from numba.extending import overload
 
 from colonsim import laws
+from colonsim.insertion.engine._compile import with_constant
 from colonsim.insertion.engine.shell_hinges import fast_atan, hinge_terms, hinge_terms_of_edges
 from colonsim.insertion.engine.shell_membrane import membrane_terms
 
 BLOCK = 64  # elements per block: its arrays (~11 kB for hinges) stay in L1 (32 and 128 measured slower or equal)
-_OGDEN = laws.OGDEN_INDEX
-_MOONEY_RIVLIN_3 = laws.LAWS["mooney_rivlin_3"].index
-_MOONEY_RIVLIN_2 = laws.LAWS["mooney_rivlin_2"].index
-_NEO_HOOKEAN = laws.LAWS["neo_hookean"].index
-_YEOH = laws.LAWS["yeoh"].index
 
 
 def triangle_reference(dm_inv, area0, thickness):
@@ -68,6 +67,23 @@ def _membrane_block(d, ref, start, nb, law, p, h, w, ok):
         h[5, j] = h2[2]
 
 
+def _membrane_block_of(law, d, ref, start, nb, p, h, w, ok):
+    """:func:`_membrane_block` of the law ``law``, a constant of the calling kernel, chosen while
+    the kernel is compiled (the overload below): each kernel compiles one law's loop."""
+
+
+@overload(_membrane_block_of, inline="always", prefer_literal=True)
+def _membrane_block_of_law(law, d, ref, start, nb, p, h, w, ok):
+    if not isinstance(law, types.IntegerLiteral):
+        raise TypeError("the wall law of a force kernel must be a compile-time constant")
+    k = law.literal_value
+
+    def block(law, d, ref, start, nb, p, h, w, ok):
+        _membrane_block(d, ref, start, nb, k, p, h, w, ok)
+
+    return block
+
+
 @numba.njit(cache=True, inline="always")
 def _membrane_chunk(x, tri, ref, law, p, lo, hi, f):
     """Membrane forces of triangles lo..hi added onto f; returns (energy J, inverted count)."""
@@ -87,16 +103,7 @@ def _membrane_chunk(x, tri, ref, law, p, lo, hi, f):
             for k in range(3):
                 d[k, j] = x[i1, k] - x[i0, k]
                 d[3 + k, j] = x[i2, k] - x[i0, k]
-        if law == _MOONEY_RIVLIN_3:
-            _membrane_block(d, ref, start, nb, _MOONEY_RIVLIN_3, p, h, w, ok)
-        elif law == _MOONEY_RIVLIN_2:
-            _membrane_block(d, ref, start, nb, _MOONEY_RIVLIN_2, p, h, w, ok)
-        elif law == _NEO_HOOKEAN:
-            _membrane_block(d, ref, start, nb, _NEO_HOOKEAN, p, h, w, ok)
-        elif law == _YEOH:
-            _membrane_block(d, ref, start, nb, _YEOH, p, h, w, ok)
-        else:
-            _membrane_block(d, ref, start, nb, law, p, h, w, ok)  # Ogden's (and NaN for an unknown law)
+        _membrane_block_of(law, d, ref, start, nb, p, h, w, ok)
         for j in range(nb):
             e = start + j
             if ok[j] == 0.0:
@@ -248,8 +255,60 @@ def _elementwise_chunk(x, tri, ref, law, p, hinge, stiffness, theta0, t_lo, t_hi
     return e_mem, n_inv, e_bend, n_bad
 
 
+@numba.njit(cache=True, inline="always")
+def _chunk(out, c, zero, nt, nh):
+    """Chunk ``c``'s nodal forces (zeroed if ``zero``), triangles t_lo..t_hi and hinges h_lo..h_hi."""
+    n_chunks = out.shape[0]
+    f = out[c]
+    if zero:
+        f[:, :] = 0.0
+    return f, c * nt // n_chunks, (c + 1) * nt // n_chunks, c * nh // n_chunks, (c + 1) * nh // n_chunks
+
+
+@numba.njit(cache=True, inline="always")
+def _store_chunk(energy, count, c, e_mem, n_inv, e_bend, n_bad):
+    """Chunk ``c``'s energies and counts of bad elements."""
+    energy[c, 0] = e_mem
+    energy[c, 1] = e_bend
+    count[c, 0] = n_inv
+    count[c, 1] = n_bad
+
+
+@numba.njit(cache=True, inline="always")
+def _blocked_forces(x, tri, ref, law, params, hinge, stiffness, theta0, out, zero, energy, count):
+    """The blocked pass of :func:`internal_forces` for the constant ``law``."""
+    for c in numba.prange(out.shape[0]):
+        f, t_lo, t_hi, h_lo, h_hi = _chunk(out, c, zero, tri.shape[0], hinge.shape[0])
+        e_mem, n_inv = _membrane_chunk(x, tri, ref, law, params, t_lo, t_hi, f)
+        e_bend, n_bad = _hinge_chunk(x, hinge, stiffness, theta0, h_lo, h_hi, f)
+        _store_chunk(energy, count, c, e_mem, n_inv, e_bend, n_bad)
+
+
+def _blocked_law(x, tri, ref, params, hinge, stiffness, theta0, out, zero, energy, count):
+    """The blocked pass for the law ``_LAW``, a global constant bound in each copy (below)."""
+    _blocked_forces(x, tri, ref, _LAW, params, hinge, stiffness, theta0, out, zero, energy, count)  # noqa: F821
+
+
+# One blocked kernel per law (law index -> kernel), each compiled on its first call: a kernel holding
+# every law's loop and the element-by-element pass took 34-38 s to compile, one law's kernel 12-15 s
+# (on a loaded machine; docs/notes/2026-12-07-compile-time.md). Threaded even for one chunk: the same
+# source compiled serially ran the benchmark tube's steps 1.4 times slower.
+_LAW_INDICES = {**{name: law.index for name, law in laws.LAWS.items()}, "ogden": laws.OGDEN_INDEX}
+BLOCKED_KERNELS = {index: numba.njit(parallel=True, cache=True)(with_constant(_blocked_law, "_" + name, _LAW=index))
+                   for name, index in _LAW_INDICES.items()}
+
+
 @numba.njit(parallel=True, cache=True)
-def internal_forces_kernel(x, tri, ref, law, params, hinge, stiffness, theta0, out, zero, energy, count, blocked):
+def elementwise_forces_kernel(x, tri, ref, law, params, hinge, stiffness, theta0, out, zero, energy, count):
+    """The element-by-element pass of :func:`internal_forces` (the law a run-time value)."""
+    for c in numba.prange(out.shape[0]):
+        f, t_lo, t_hi, h_lo, h_hi = _chunk(out, c, zero, tri.shape[0], hinge.shape[0])
+        e_mem, n_inv, e_bend, n_bad = _elementwise_chunk(x, tri, ref, law, params, hinge, stiffness, theta0,
+                                                         t_lo, t_hi, h_lo, h_hi, f)
+        _store_chunk(energy, count, c, e_mem, n_inv, e_bend, n_bad)
+
+
+def internal_forces(x, tri, ref, law, params, hinge, stiffness, theta0, out, zero, energy, count, blocked=True):
     """Membrane and hinge forces of the wall onto per-thread nodal arrays, by blocks or element by
     element (``blocked``; module docstring).
 
@@ -257,6 +316,8 @@ def internal_forces_kernel(x, tri, ref, law, params, hinge, stiffness, theta0, o
     ----------
     ref : (5, nt) float64
         The triangles' reference quantities (:func:`triangle_reference`).
+    law : int
+        The wall law's index (:data:`colonsim.laws.LAWS`, Ogden's :data:`colonsim.laws.OGDEN_INDEX`).
     out : (n_chunks, n, 3) float64
         Per-chunk nodal forces, added to (set to zero first if ``zero``).
     energy : (n_chunks, 2) float64
@@ -264,24 +325,10 @@ def internal_forces_kernel(x, tri, ref, law, params, hinge, stiffness, theta0, o
     count : (n_chunks, 2) int64
         Inverted triangles and collapsed hinges of each chunk (written).
     """
-    n_chunks = out.shape[0]
-    nt = tri.shape[0]
-    nh = hinge.shape[0]
-    for c in numba.prange(n_chunks):
-        f = out[c]
-        if zero:
-            f[:, :] = 0.0
-        t_lo = c * nt // n_chunks
-        t_hi = (c + 1) * nt // n_chunks
-        h_lo = c * nh // n_chunks
-        h_hi = (c + 1) * nh // n_chunks
-        if blocked:
-            e_mem, n_inv = _membrane_chunk(x, tri, ref, law, params, t_lo, t_hi, f)
-            e_bend, n_bad = _hinge_chunk(x, hinge, stiffness, theta0, h_lo, h_hi, f)
-        else:
-            e_mem, n_inv, e_bend, n_bad = _elementwise_chunk(x, tri, ref, law, params, hinge, stiffness, theta0,
-                                                             t_lo, t_hi, h_lo, h_hi, f)
-        energy[c, 0] = e_mem
-        energy[c, 1] = e_bend
-        count[c, 0] = n_inv
-        count[c, 1] = n_bad
+    if not blocked:
+        elementwise_forces_kernel(x, tri, ref, law, params, hinge, stiffness, theta0, out, zero, energy, count)
+        return
+    kernel = BLOCKED_KERNELS.get(law)
+    if kernel is None:
+        raise ValueError(f"no wall law has the index {law}; the laws are {sorted(BLOCKED_KERNELS)}")
+    kernel(x, tri, ref, params, hinge, stiffness, theta0, out, zero, energy, count)
