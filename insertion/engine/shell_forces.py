@@ -31,8 +31,6 @@ import math
 
 import numba
 import numpy as np
-from numba.core import types
-from numba.extending import overload
 
 from colonsim import laws
 from colonsim.insertion.engine._compile import with_constant
@@ -67,26 +65,11 @@ def _membrane_block(d, ref, start, nb, law, p, h, w, ok):
         h[5, j] = h2[2]
 
 
-def _membrane_block_of(law, d, ref, start, nb, p, h, w, ok):
-    """:func:`_membrane_block` of the law ``law``, a constant of the calling kernel, chosen while
-    the kernel is compiled (the overload below): each kernel compiles one law's loop."""
+def _membrane_chunk(x, tri, ref, p, lo, hi, f):
+    """Membrane forces of triangles lo..hi added onto f; returns (energy J, inverted count).
 
-
-@overload(_membrane_block_of, inline="always", prefer_literal=True)
-def _membrane_block_of_law(law, d, ref, start, nb, p, h, w, ok):
-    if not isinstance(law, types.IntegerLiteral):
-        raise TypeError("the wall law of a force kernel must be a compile-time constant")
-    k = law.literal_value
-
-    def block(law, d, ref, start, nb, p, h, w, ok):
-        _membrane_block(d, ref, start, nb, k, p, h, w, ok)
-
-    return block
-
-
-@numba.njit(cache=True, inline="always")
-def _membrane_chunk(x, tri, ref, law, p, lo, hi, f):
-    """Membrane forces of triangles lo..hi added onto f; returns (energy J, inverted count)."""
+    The law is the global constant ``_LAW``, bound in each law's copy (:data:`BLOCKED_KERNELS`),
+    where Numba drops the other laws' branches before compiling."""
     d = np.empty((6, BLOCK))
     h = np.empty((6, BLOCK))
     w = np.empty(BLOCK)
@@ -103,7 +86,7 @@ def _membrane_chunk(x, tri, ref, law, p, lo, hi, f):
             for k in range(3):
                 d[k, j] = x[i1, k] - x[i0, k]
                 d[3 + k, j] = x[i2, k] - x[i0, k]
-        _membrane_block_of(law, d, ref, start, nb, p, h, w, ok)
+        _membrane_block(d, ref, start, nb, _LAW, p, h, w, ok)  # noqa: F821
         for j in range(nb):
             e = start + j
             if ok[j] == 0.0:
@@ -274,28 +257,30 @@ def _store_chunk(energy, count, c, e_mem, n_inv, e_bend, n_bad):
     count[c, 1] = n_bad
 
 
-@numba.njit(cache=True, inline="always")
-def _blocked_forces(x, tri, ref, law, params, hinge, stiffness, theta0, out, zero, energy, count):
-    """The blocked pass of :func:`internal_forces` for the constant ``law``."""
+def _blocked_law(x, tri, ref, params, hinge, stiffness, theta0, out, zero, energy, count):
+    """The blocked pass of :func:`internal_forces` with the law's ``_membrane_chunk`` bound in
+    each law's copy (below)."""
     for c in numba.prange(out.shape[0]):
         f, t_lo, t_hi, h_lo, h_hi = _chunk(out, c, zero, tri.shape[0], hinge.shape[0])
-        e_mem, n_inv = _membrane_chunk(x, tri, ref, law, params, t_lo, t_hi, f)
+        e_mem, n_inv = _membrane_chunk(x, tri, ref, params, t_lo, t_hi, f)
         e_bend, n_bad = _hinge_chunk(x, hinge, stiffness, theta0, h_lo, h_hi, f)
         _store_chunk(energy, count, c, e_mem, n_inv, e_bend, n_bad)
 
 
-def _blocked_law(x, tri, ref, params, hinge, stiffness, theta0, out, zero, energy, count):
-    """The blocked pass for the law ``_LAW``, a global constant bound in each copy (below)."""
-    _blocked_forces(x, tri, ref, _LAW, params, hinge, stiffness, theta0, out, zero, energy, count)  # noqa: F821
+def _law_kernel(name, index):
+    """The blocked kernel of one law: copies of :func:`_membrane_chunk` with ``_LAW`` bound to its
+    index and of :func:`_blocked_law` calling that copy, each under a name of its own (its own
+    cache entry)."""
+    chunk = numba.njit(inline="always")(with_constant(_membrane_chunk, "_" + name, _LAW=index))
+    return numba.njit(parallel=True, cache=True)(with_constant(_blocked_law, "_" + name, _membrane_chunk=chunk))
 
 
 # One blocked kernel per law (law index -> kernel), each compiled on its first call: a kernel holding
-# every law's loop and the element-by-element pass took 34-38 s to compile, one law's kernel 12-15 s
-# (on a loaded machine; docs/notes/2026-12-07-compile-time.md). Threaded even for one chunk: the same
-# source compiled serially ran the benchmark tube's steps 1.4 times slower.
+# every law's loop and the element-by-element pass took 34-38 s to compile, one law's kernel about
+# 9 s (on a loaded machine; docs/notes/2026-12-07-compile-time.md). Threaded even for one chunk: the
+# same source compiled serially ran the benchmark tube's steps 1.4 times slower.
 _LAW_INDICES = {**{name: law.index for name, law in laws.LAWS.items()}, "ogden": laws.OGDEN_INDEX}
-BLOCKED_KERNELS = {index: numba.njit(parallel=True, cache=True)(with_constant(_blocked_law, "_" + name, _LAW=index))
-                   for name, index in _LAW_INDICES.items()}
+BLOCKED_KERNELS = {index: _law_kernel(name, index) for name, index in _LAW_INDICES.items()}
 
 
 @numba.njit(parallel=True, cache=True)
