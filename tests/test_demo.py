@@ -20,10 +20,15 @@ from colonsim.demo import DemoOptions, Sections, run_demo
 from colonsim.demo_predictor import NO_PREDICTOR, comparison, comparison_line, predictor_step
 from colonsim.demo_report import write_report
 from colonsim.demo_sweep import REPLICATE_MESH
+from colonsim.identification.search import Budget
 from colonsim.insertion.case.insertion_case import InsertionCase
 from colonsim.surrogate import predictor
 
 from predictor_fixture import synthetic_patient_table
+
+# the calibration at a third of --quick's evaluations (the demo's own budget took 24 of its 80 s here):
+# its material only has to be a calibrated one, as the smoke mesh's runs only have to run
+CALIBRATION = Budget(designs=12, cma_popsize=6, cma_max_evaluations=36, nm_max_evaluations=60)
 
 
 def tiny_rsj_predictor(folder):
@@ -44,7 +49,8 @@ def test_demo_runs_every_workflow_and_writes_one_folder(tmp_path, capsys, monkey
     monkeypatch.setattr(predictor, "SHIPPED", tmp_path / "none")  # no predictor ships: said in one line
     monkeypatch.delenv(predictor.OVERRIDE, raising=False)
     made = run_demo(DemoOptions(out=out, element_size_mm=SMOKE_ELEMENT_MM, scope_spacing_mm=SMOKE_SCOPE_SPACING_MM,
-                                push_speed=SMOKE_PUSH_SPEED, sweep=True, show_progress=False))
+                                push_speed=SMOKE_PUSH_SPEED, sweep=True, show_progress=False,
+                                calibration_budget=CALIBRATION))
     text = capsys.readouterr().out
     for step in (1, 2, 3, 5, 6, 7):
         assert f"== {step}/7 " in text
