@@ -35,15 +35,15 @@ PATIENT_PARTS = {"heldout": (30, 100), "replicates": (10, 200)}
 # More training runs where one hypercube leaves the response unresolved: model -> (runs, seed offset)
 # of each further, independent Latin hypercube over the training ranges (parts "more", "more2", ...).
 # THF's 72 runs predicted its held-out runs with an RMSE of half its spread and intervals too narrow
-# (its loops snap through at some angles and not at others), and 144 still too narrow,
-# docs/surrogate.md "How well it predicts".
+# (its loops snap through at some angles and not at others), 144 still too narrow; 216 met the
+# bands, docs/surrogate.md "How well it predicts".
 PATIENT_MORE = {"thf": ((72, 300), (72, 400))}
+REPLICATE_MESHES_MM = (3.0, 2.8)
 
 
 def more_parts(model: str) -> tuple:
     """The part names of ``model``'s further training hypercubes: "more", "more2", ..."""
     return tuple("more" + (str(i + 1) if i else "") for i in range(len(PATIENT_MORE.get(model, ()))))
-REPLICATE_MESHES_MM = (3.0, 2.8)
 
 
 def patient_space_name(model: str, part: str = "") -> str:
@@ -53,8 +53,8 @@ def patient_space_name(model: str, part: str = "") -> str:
 
 def patient_space(model: str, part: str = "") -> str:
     """The TOML of the patient-space sweep of ``model``: its training runs (``part`` ""), more of
-    them ("more", "more2": further hypercubes, :data:`PATIENT_MORE`), its held-out runs ("heldout") or its
-    replicate pairs ("replicates").
+    them ("more", "more2": further hypercubes, :data:`PATIENT_MORE`), its held-out runs
+    ("heldout") or its replicate pairs ("replicates").
 
     The held-out and replicate hypercubes span each range less one training stratum (range /
     training runs) at either end: a Latin hypercube puts a training run in each end stratum, so
@@ -68,7 +68,8 @@ def patient_space(model: str, part: str = "") -> str:
         index = more_parts(model).index(part)
         runs, offset = PATIENT_MORE[model][index]
         seed += offset
-        what = f"more training runs of the shipped predictor (a {('second', 'third', 'fourth')[index]} hypercube)"
+        ordinal = ("second", "third", "fourth")[index] if index < 3 else f"{index + 2}th"
+        what = f"more training runs of the shipped predictor (a {ordinal} hypercube)"
     elif part:
         ranges = {n: (math.ceil(1e3 * (lo + (hi - lo) / runs)) / 1e3, math.floor(1e3 * (hi - (hi - lo) / runs)) / 1e3)
                   for n, (lo, hi) in ranges.items()}  # rounded inwards, to the hypercube's 3 decimals
