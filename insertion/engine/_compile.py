@@ -16,13 +16,20 @@ import types
 import numba
 
 
+def _renamed_copy(py_func, suffix, module_globals):
+    """A copy of ``py_func`` reading ``module_globals``, named ``py_func``'s name + ``suffix``
+    (its own cache entry)."""
+    copy = types.FunctionType(py_func.__code__, module_globals, py_func.__name__ + suffix, py_func.__defaults__,
+                              py_func.__closure__)
+    copy.__qualname__ = py_func.__qualname__ + suffix
+    copy.__doc__ = py_func.__doc__
+    return copy
+
+
 def threaded_and_serial(py_func):
     """(threaded, serial) dispatchers of ``py_func``, a kernel whose main loop is ``numba.prange``
     (a plain ``range`` when compiled serially), both cached."""
-    serial = types.FunctionType(py_func.__code__, py_func.__globals__, py_func.__name__ + "_serial",
-                                py_func.__defaults__, py_func.__closure__)
-    serial.__qualname__ = py_func.__qualname__ + "_serial"
-    serial.__doc__ = py_func.__doc__
+    serial = _renamed_copy(py_func, "_serial", py_func.__globals__)
     return numba.njit(parallel=True, cache=True)(py_func), numba.njit(cache=True)(serial)
 
 
@@ -30,8 +37,4 @@ def with_constant(py_func, suffix, **constants):
     """A copy of ``py_func`` whose module globals also bind ``constants`` (which Numba freezes
     into the machine code), named ``py_func``'s name + ``suffix`` so that each copy has its own
     cache entry; jit it as the original would be."""
-    copy = types.FunctionType(py_func.__code__, {**py_func.__globals__, **constants}, py_func.__name__ + suffix,
-                              py_func.__defaults__, py_func.__closure__)
-    copy.__qualname__ = py_func.__qualname__ + suffix
-    copy.__doc__ = py_func.__doc__
-    return copy
+    return _renamed_copy(py_func, suffix, {**py_func.__globals__, **constants})
