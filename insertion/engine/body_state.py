@@ -37,6 +37,8 @@ class BodyState:
         self.f_damp = np.zeros((n, 3))
         self.reaction = np.zeros((n, 3))
         self.fixed = np.zeros(n, dtype=np.uint8)
+        self.every_node = np.arange(n, dtype=np.int64)
+        self.moving = self.every_node  # the nodes the explicit update visits (:meth:`leave_out_quiet`)
         # a body with dashpots (a rod's strain-rate damping) takes an implicit velocity update
         # with its constraints as rows (:mod:`colonsim.insertion.engine.rod_damping`)
         dashpot = getattr(body, "dashpot", None)
@@ -52,6 +54,21 @@ class BodyState:
         self.work_external = 0.0
         self.work_reaction = 0.0
         self.dissipated_damping = 0.0
+
+    def leave_out_quiet(self, quiet):
+        """Visit every node in the explicit update but the ``quiet`` ones (bool (n,), or None for none).
+
+        A quiet node is held, at rest, and no force can reach it until the solver says otherwise
+        (no element of the body's that is not all held, no contact's candidate, no load): its update
+        is zeros (the integrator kernels' held branch) and leaves its position alone, so it is
+        written as zeros once, here, and left out after. On a colon model most of the wall is such
+        (RSF: 8,280 of 11,320 nodes), and the nodal updates then stream a quarter of the arrays."""
+        if quiet is None or not quiet.any():
+            self.moving = self.every_node
+            return
+        for a in (self.v_new, self.f_damp, self.reaction):
+            a[quiet] = 0.0
+        self.moving = np.flatnonzero(~quiet)
 
 
 @numba.njit(cache=True)
@@ -119,9 +136,10 @@ def step_body(s, constraints, alpha, t, t_mid, dt_mid, dt, resistances=()):
         kernel = velocity_kernel if s.parallel else velocity_kernel_serial
 
         def update():
-            kernel(s.v, s.f_int, s.f_con, s.f_ext, b.mass, s.fixed, alpha, dt_mid, s.v_new, s.f_damp, s.reaction)
+            kernel(s.moving, s.v, s.f_int, s.f_con, s.f_ext, b.mass, s.fixed, alpha, dt_mid, s.v_new, s.f_damp,
+                   s.reaction)
         resisted_update(resistances, s, update, outputs)
         for c in constraints:
             c.reaction = c.constrain_rates(t_mid, s, dt_mid) if c.active(t) else np.zeros(3)
     kernel = advance_kernel if s.parallel else advance_kernel_serial
-    return kernel(s.x, s.v, s.v_new, b.mass, s.f_int, s.f_con, s.f_ext, s.f_damp, s.reaction, dt_mid, dt)
+    return kernel(s.moving, s.x, s.v, s.v_new, b.mass, s.f_int, s.f_con, s.f_ext, s.f_damp, s.reaction, dt_mid, dt)

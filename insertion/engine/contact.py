@@ -170,6 +170,18 @@ class RodShellContact:
     # -- broad phase -------------------------------------------------------------------------
 
     @property
+    def revision(self):
+        """Changes whenever the candidates change (what :meth:`nodes_on` returns)."""
+        return self.n_rebuilds
+
+    def nodes_on(self, body):
+        """The nodes of ``body`` this contact may put a force on until its candidates are rebuilt
+        (None: any of them)."""
+        if body is self.shell:
+            return self.points.nodes[self._points].ravel()
+        return None
+
+    @property
     def n_candidates(self):
         """Candidate (contact point, segment) pairs of the current list."""
         return len(self._cand)

@@ -2,7 +2,9 @@
 velocity update and the position update with the work of each force family.
 
 Each kernel is one source compiled threaded and serial (:mod:`._compile`); the solver picks the
-serial one for bodies too small to pay for threads.
+serial one for bodies too small to pay for threads. Both visit the nodes listed in ``nodes`` (in
+that order): every node, or all but the wall's quiet held nodes, whose update is zeros
+(:meth:`colonsim.insertion.engine.body_state.BodyState.leave_out_quiet`).
 """
 
 import numba
@@ -10,14 +12,16 @@ import numba
 from colonsim.insertion.engine._compile import threaded_and_serial
 
 
-def _velocity_update(v, f_int, f_con, f_ext, mass, fixed, alpha, dt, v_new, f_damp, reaction):
-    """Damped velocity update into ``v_new``; fixed nodes get zero velocity and their reaction.
+def _velocity_update(nodes, v, f_int, f_con, f_ext, mass, fixed, alpha, dt, v_new, f_damp, reaction):
+    """Damped velocity update of ``nodes`` into ``v_new``; fixed nodes get zero velocity and their
+    reaction.
 
     The loop body is written out here: as an inlined function of a node, the branch for held
     nodes made the loop 25 times slower (measured)."""
     h = 0.5 * alpha * dt
     keep = (1.0 - h) / (1.0 + h)
-    for i in numba.prange(v.shape[0]):
+    for j in numba.prange(nodes.shape[0]):
+        i = nodes[j]
         if fixed[i] and v[i, 0] == 0.0 and v[i, 1] == 0.0 and v[i, 2] == 0.0 \
                 and f_int[i, 0] + f_con[i, 0] + f_ext[i, 0] == 0.0 and f_int[i, 1] + f_con[i, 1] + f_ext[i, 1] == 0.0 \
                 and f_int[i, 2] + f_con[i, 2] + f_ext[i, 2] == 0.0:
@@ -69,8 +73,9 @@ def _advance_node(i, x, v, v_new, mass, f_int, f_con, f_ext, f_damp, reaction, d
     return w_int, w_con, w_ext, w_damp, w_react, kinetic
 
 
-def _advance(x, v, v_new, mass, f_int, f_con, f_ext, f_damp, reaction, dt_mid, dt):
-    """Work increments of each force family, mid-step kinetic energy; then x += dt v_new, v = v_new.
+def _advance(nodes, x, v, v_new, mass, f_int, f_con, f_ext, f_damp, reaction, dt_mid, dt):
+    """Work increments of each force family, mid-step kinetic energy; then x += dt v_new, v = v_new,
+    at ``nodes`` (a node left out must be at rest, v = v_new = 0: it adds nothing).
 
     Returns
     -------
@@ -84,8 +89,8 @@ def _advance(x, v, v_new, mass, f_int, f_con, f_ext, f_damp, reaction, dt_mid, d
     w_damp = 0.0
     w_react = 0.0
     kinetic = 0.0
-    for i in numba.prange(x.shape[0]):
-        a, b, c, d, e, k = _advance_node(i, x, v, v_new, mass, f_int, f_con, f_ext, f_damp, reaction, dt)
+    for j in numba.prange(nodes.shape[0]):
+        a, b, c, d, e, k = _advance_node(nodes[j], x, v, v_new, mass, f_int, f_con, f_ext, f_damp, reaction, dt)
         w_int += a
         w_con += b
         w_ext += c

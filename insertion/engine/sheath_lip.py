@@ -131,6 +131,12 @@ class SheathLip:
         lip_kernel(r.x, r.v, r.f_con, self.point, self.direction, self.lip, self.stiffness, self._dashpot, self._out)
         self.energy = float(self._out[2])
 
+    revision = 0  # what nodes_on returns never changes
+
+    def nodes_on(self, body):
+        """The nodes of ``body`` the lip may put a force on: any of the rod's (None), none of another body's."""
+        return None if body is self.rod else np.zeros(0, dtype=np.int64)
+
     @property
     def force(self):
         """The lip's force on the rod at the last evaluation, N (3,)."""

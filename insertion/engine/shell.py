@@ -24,10 +24,10 @@ import numpy as np
 from colonsim.errors import ColonsimError
 from colonsim.insertion.engine._scatter import gather, node_incidence
 from colonsim.insertion.engine.sheet_mesh import hinges as mesh_hinges
+from colonsim.insertion.engine.shell_bounds import SplitBounds
 from colonsim.insertion.engine.shell_forces import internal_forces, triangle_reference
-from colonsim.insertion.engine.shell_hinges import (bending_stiffness, dihedral_angles, hinge_rowsum_kernel,
-                                                    hinge_stiffness, max_row_over_mass)
-from colonsim.insertion.engine.shell_membrane import check_dispatched, membrane_omega2_kernel, reference_frames
+from colonsim.insertion.engine.shell_hinges import bending_stiffness, dihedral_angles, hinge_stiffness
+from colonsim.insertion.engine.shell_membrane import check_dispatched, reference_frames
 
 # ---------------------------------------------------------------------------------------------
 # Internal forces: the per-thread arrays summed
@@ -180,9 +180,6 @@ class Shell:
         self._tri_ptr, self._tri_slots = node_incidence(triangles, len(nodes))
         self._tri_buf = np.zeros((len(triangles), 3, 3))
         self._hinge_ptr, self._hinge_slots = node_incidence(h.reshape(-1, 4), len(nodes))
-        self._hinge_buf = np.zeros((len(h), 4, 3))
-        self._omega2 = np.zeros(len(triangles))
-        self._node_tmp = np.zeros((len(nodes), 3))
         self._mass_scale = np.ones(len(nodes))
         self._chunk_f = np.zeros((0,) + nodes.shape)  # per-thread nodal forces, sized on first use
         self._chunk_energy = np.zeros((0, 2))
@@ -208,6 +205,12 @@ class Shell:
                 (self.triangles, tri_on), (self.dm_inv, tri_on), (self.area0, tri_on), (self.hinges, hinge_on),
                 (self.hinge_stiffness, hinge_on), (self.theta0, hinge_on)))
         self._active_reference = triangle_reference(self._active[1], self._active[2], self.thickness)
+        self._bounds = SplitBounds(self, tri_on, hinge_on)  # the held elements' part kept
+        self._force_nodes = np.unique(np.concatenate((self._active[0].ravel(), self._active[3].ravel())))
+
+    def force_nodes(self):
+        """The nodes the internal forces may reach: those of the triangles and hinges not all held."""
+        return self._force_nodes
 
     @property
     def n_nodes(self):
@@ -284,18 +287,7 @@ class Shell:
         # per-node scaling factor relative to the physical lumped mass.
         scale = self._mass_scale
         np.divide(self.mass, self._lumped_mass, out=scale)
-        membrane_omega2_kernel(
-            x, self.triangles, self.dm_inv, self.thickness, self.density, self._law, self._law_params, scale,
-            self._omega2,
-        )
-        membrane = float(self._omega2.max())
-        if not len(self.hinges):
-            return membrane, 0.0
-        hinge_rowsum_kernel(x, self.hinges, self.hinge_stiffness, self.theta0, self._hinge_buf)
-        rows = self._node_tmp
-        rows[:] = 0.0
-        gather(self._hinge_buf, self._hinge_ptr, self._hinge_slots, rows)
-        return membrane, max_row_over_mass(rows, self.mass)
+        return self._bounds.bounds(x, scale)
 
     def critical_time_step(self, x):
         """Conservative stable central-difference time step at configuration x, s.

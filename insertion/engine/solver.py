@@ -155,6 +155,7 @@ class ExplicitSolver:
         self._dt_prev = None
         self._fixed_key = None
         self._held_key = None
+        self._quiet_key = None
         self._rest_key = ()
         self._rest_key_since = self._rest_key_until = -math.inf  # an empty window: asked at the first step
         self._rest_key_count = 0
@@ -242,6 +243,29 @@ class ExplicitSolver:
             if on:
                 self.state[c.body.name].fixed[c.nodes] = 1
 
+    def _leave_out_quiet(self, bodies):
+        """Tell each body which nodes its explicit update may leave out (:meth:`BodyState.leave_out_quiet`):
+        held, at rest, on no element that is not all held, on no contact's candidate and on a body
+        no load or resistance acts on. Asked again whenever the held nodes change or a contact
+        revises the nodes it may reach (its ``revision``); a body or contact that cannot say
+        (no ``force_nodes`` / ``nodes_on``) leaves nothing out."""
+        key = (self._fixed_key, tuple(getattr(c, "revision", None) for c in self.contacts))
+        if key == self._quiet_key and None not in key[1]:
+            return
+        self._quiet_key = key
+        for s, _, _, written in bodies:
+            quiet = None
+            if not (s.implicit or written or s.parallel) and hasattr(s.body, "force_nodes"):
+                quiet = (s.fixed != 0) & ~(s.v != 0.0).any(axis=1)
+                quiet[s.body.force_nodes()] = False
+                for c in self.contacts:
+                    reach = c.nodes_on(s.body) if hasattr(c, "nodes_on") else None
+                    if reach is None:
+                        quiet = None
+                        break
+                    quiet[reach] = False
+            s.leave_out_quiet(quiet)
+
     def _hold_elements(self, t):
         """Tell bodies that leave held elements out (a shell: :meth:`Shell.hold`) which of their
         nodes the constraints active at ``t`` hold, whenever that set changes (before the step's
@@ -291,6 +315,7 @@ class ExplicitSolver:
             if load.active(t):
                 load.add_forces(t, self.state[load.body.name].f_ext)
         self._refresh_fixed(t)
+        self._leave_out_quiet(bodies)
         energy = 0.0
         work_in = 0.0
         for s, constraints, resistances, _ in bodies:
