@@ -23,8 +23,8 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from colonsim.insertion.case.outcomes import (JAM_PUSH, arc_along, jammed, principal_stretches,
-                                             sliding_kinetic_energy, tip_heading)
+from colonsim.insertion.case.outcomes import (JAM_PUSH, arc_along, jammed, largest_displacement,
+                                             principal_stretches, sliding_kinetic_energy, tip_heading)
 from colonsim.insertion.case.stretch_map import WallStretch, attach
 
 
@@ -38,7 +38,7 @@ class InsertionRecorder:
         self.snapshot_interval = snapshot_interval
         self._next_snapshot = 0.0
         g = model.geometry
-        self._mobile = model.mobile_nodes
+        self._mobile = np.ascontiguousarray(model.mobile_nodes, dtype=np.int64)
         # held triangles stay at rest (stretch 1): the largest stretch is that of the others, and
         # the wall-stretch map keeps each one's largest over the run from the same measurement
         held = np.zeros(len(model.shell.x0), dtype=bool)
@@ -62,10 +62,7 @@ class InsertionRecorder:
         m = self.model
         colon = solver.state["colon"]
         scope = solver.state[m.rod.name]
-        if self._mobile.size:
-            deformation = float(np.sqrt(((colon.x[self._mobile] - m.shell.x0[self._mobile]) ** 2).sum(axis=1).max()))
-        else:
-            deformation = 0.0
+        deformation = largest_displacement(colon.x, m.shell.x0, self._mobile)
         tip = scope.x[self._tip]
         depth = m.push.depth(solver.time)
         tip_arc = float(arc_along(self._arc_points, self._arc, self._arc_tangents, tip))

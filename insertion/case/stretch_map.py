@@ -30,7 +30,7 @@ import numpy as np
 from colonsim.catalog import STRETCHED_WALL_COLUMN, STRETCHED_WALL_THRESHOLD, STRETCHED_WALL_THRESHOLD_RANGE
 from colonsim.errors import ColonsimError
 from colonsim.files import atomic_path
-from colonsim.insertion.case.outcomes import characteristic_points
+from colonsim.insertion.case.outcomes import characteristic_points, mark_loaded
 
 STRETCH_MAP = "stretch_map.npz"  # the map's file in a run folder
 # the prominence a maximum needs to be point A, as characteristic_points judges it
@@ -77,7 +77,7 @@ class WallStretch:
         else:
             np.maximum(self.largest, stretches, out=self.largest)
         if wall_contact_force is not None:
-            self.touched |= (wall_contact_force != 0.0).any(axis=1)
+            mark_loaded(wall_contact_force, self.touched)
         u = float(deformation)
         i = self._count
         previous = self._deformation[i - 1] if i else None

@@ -12,8 +12,8 @@ import numpy as np
 
 from colonsim.errors import ColonsimError
 from colonsim.insertion.engine.constraints import FREE, ON_LINE
-from colonsim.insertion.engine.integrator_kernels import (advance_kernel, advance_kernel_serial, velocity_kernel,
-                                                          velocity_kernel_serial)
+from colonsim.insertion.engine.integrator_kernels import (advance_kernel, advance_kernel_serial, clear_rows,
+                                                          velocity_kernel, velocity_kernel_serial)
 from colonsim.insertion.engine.rod_damping import damped_rod_velocity, merge_rows
 from colonsim.insertion.engine.tip_resistance import resisted_update
 
@@ -54,6 +54,17 @@ class BodyState:
         self.work_external = 0.0
         self.work_reaction = 0.0
         self.dissipated_damping = 0.0
+
+    def clear_forces(self, external):
+        """Zero the internal and contact force buffers (and the external ones if ``external``)
+        before a step's forces: the rows of the nodes left out are zero already and stay so."""
+        if self.moving is self.every_node:
+            self.f_int[:] = 0.0
+            self.f_con[:] = 0.0
+        else:
+            clear_rows(self.moving, self.f_int, self.f_con)
+        if external:
+            self.f_ext[:] = 0.0
 
     def leave_out_quiet(self, quiet):
         """Visit every node in the explicit update but the ``quiet`` ones (bool (n,), or None for none).

@@ -139,9 +139,15 @@ class FixedNodes(Constraint):
 
     def __init__(self, body, nodes, start=0.0, end=math.inf):
         self._init_window(body, nodes, start, end)
+        self._summed = (None, self.nodes)  # (the body's moving nodes, the nodes of ours among them)
 
     def constrain_rates(self, t_mid, state, dt_mid):
-        return _row_sum(state.reaction, self.nodes)
+        # the reactions of the nodes the update leaves out are zero: the sum skips them (same bits)
+        moving = getattr(state, "moving", None)
+        if moving is not self._summed[0]:
+            every = moving is None or moving is state.every_node
+            self._summed = (moving, self.nodes if every else np.intersect1d(self.nodes, moving, assume_unique=True))
+        return _row_sum(state.reaction, self._summed[1])
 
     def velocity_rows(self, t_mid, state):
         return self.nodes, HELD, np.zeros((len(self.nodes), 3))

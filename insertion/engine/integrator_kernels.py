@@ -101,3 +101,14 @@ def _advance(nodes, x, v, v_new, mass, f_int, f_con, f_ext, f_damp, reaction, dt
 
 
 advance_kernel, advance_kernel_serial = threaded_and_serial(_advance)
+
+
+@numba.njit(cache=True)
+def clear_rows(nodes, a, b):
+    """Zero the rows ``nodes`` of the (n, 3) arrays ``a`` and ``b`` (a body's force buffers, where
+    the other rows are never written)."""
+    for j in range(nodes.shape[0]):
+        i = nodes[j]
+        for k in range(3):
+            a[i, k] = 0.0
+            b[i, k] = 0.0

@@ -302,11 +302,8 @@ class ExplicitSolver:
         bodies = self._by_body()
         try:
             for s, _, _, written in bodies:
-                s.f_int[:] = 0.0
+                s.clear_forces(written)  # nothing but loads and resistances writes f_ext: it stays zero
                 s.internal = s.body.internal_forces(s.x, s.f_int)
-                s.f_con[:] = 0.0
-                if written:  # nothing else writes f_ext: it stays zero
-                    s.f_ext[:] = 0.0
             for c in self.contacts:
                 c.compute(self.state, dt_mid)
         except ColonsimError as err:
