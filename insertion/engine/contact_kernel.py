@@ -82,71 +82,6 @@ def _nearest_segment(p0, p1, p2, xr, seg, ptr, cand, c):
     return best, best_s, best_t
 
 
-@numba.njit(cache=True)  # called for the points in reach only
-def _contact_one(c, q, p0, p1, p2, best, best_s, best_t, xs, vs, ms, fixed_s, pn, pw, ps, held_n, xr, vr, mr, seg,
-                 radius, offset, k_free, k_held, zeta, mu, v_slip, dt, rod_seg, rod_t, rod_k, rod_f, damp_f, fric_f):
-    """Contact of candidate point ``points[c]`` = ``q`` at (p0, p1, p2), in reach of its nearest
-    segment ``best_s`` (squared distance ``best``, at ``best_t``): (energy, damping power,
-    friction power, active 1, normal force). The force on the wall is ``-rod_f[c]``
-    (:func:`wall_reactions`)."""
-    reach = radius + offset
-    dist = math.sqrt(best)
-    pen = reach - dist
-    a = seg[best_s, 0]
-    b = seg[best_s, 1]
-    t = best_t
-    held = point_held(fixed_s, pn, pw, q)
-    if held and (held_n[q, 0] != 0.0 or held_n[q, 1] != 0.0 or held_n[q, 2] != 0.0):
-        # a point of the rigid fixed wall: it pushes along that wall's normal at rest
-        n0 = held_n[q, 0]
-        n1 = held_n[q, 1]
-        n2 = held_n[q, 2]
-    else:
-        n0 = (p0 - ((1.0 - t) * xr[a, 0] + t * xr[b, 0])) / dist
-        n1 = (p1 - ((1.0 - t) * xr[a, 1] + t * xr[b, 1])) / dist
-        n2 = (p2 - ((1.0 - t) * xr[a, 2] + t * xr[b, 2])) / dist
-    m = pw[q, 0] * ms[pn[q, 0]]
-    for j in range(1, pn.shape[1]):
-        m += pw[q, j] * ms[pn[q, j]]
-    m *= ps[q]
-    mrc = (1.0 - t) * mr[a] + t * mr[b]
-    meff = mrc if held else m * mrc / (m + mrc)
-    k = (k_held if held else k_free) * ps[q]
-    u0 = gather(vs, pn, pw, q, 0) - ((1.0 - t) * vr[a, 0] + t * vr[b, 0])
-    u1 = gather(vs, pn, pw, q, 1) - ((1.0 - t) * vr[a, 1] + t * vr[b, 1])
-    u2 = gather(vs, pn, pw, q, 2) - ((1.0 - t) * vr[a, 2] + t * vr[b, 2])
-    vn = u0 * n0 + u1 * n1 + u2 * n2
-    elastic = k * pen
-    fn = elastic - 2.0 * zeta * math.sqrt(k * meff) * vn
-    if fn < 0.0:
-        fn = 0.0
-    energy = 0.5 * k * pen * pen
-    p_damp = -(fn - elastic) * vn
-    damp_f[c, 0] = (fn - elastic) * n0
-    damp_f[c, 1] = (fn - elastic) * n1
-    damp_f[c, 2] = (fn - elastic) * n2
-    t0 = u0 - vn * n0
-    t1 = u1 - vn * n1
-    t2 = u2 - vn * n2
-    vt = math.sqrt(t0 * t0 + t1 * t1 + t2 * t2)
-    ft = 0.0
-    p_fric = 0.0
-    if mu > 0.0 and fn > 0.0:
-        vreg = max(v_slip, mu * fn * dt / meff)
-        ft = mu * fn / max(vt, vreg)
-        p_fric = ft * vt * vt
-    fric_f[c, 0] = -ft * t0
-    fric_f[c, 1] = -ft * t1
-    fric_f[c, 2] = -ft * t2
-    rod_seg[c] = best_s
-    rod_t[c] = t
-    rod_k[c] = k
-    rod_f[c, 0] = -(fn * n0 - ft * t0)
-    rod_f[c, 1] = -(fn * n1 - ft * t1)
-    rod_f[c, 2] = -(fn * n2 - ft * t2)
-    return energy, p_damp, p_fric, 1, fn
-
-
 def _contact_forces(xs, vs, ms, fixed_s, pn, pw, ps, held_n, xr, vr, mr, seg, points, ptr, cand, radius, offset,
                     k_free, k_held, zeta, mu, v_slip, dt, rod_seg, rod_t, rod_k, rod_f, damp_f, fric_f):
     """Penalty contact forces of the candidate points: the reaction on the rod per candidate
@@ -172,8 +107,11 @@ def _contact_forces(xs, vs, ms, fixed_s, pn, pw, ps, held_n, xr, vr, mr, seg, po
     normal = 0.0
     reach2 = (radius + offset) * (radius + offset)
     for c in numba.prange(points.shape[0]):
-        # The search and the test for reach here, the contact law apart: with the test's early
-        # return inside the inlined law, a point out of reach cost 240 ns instead of about 30 (measured).
+        # The search and the test for reach first, then the contact law written out in the loop:
+        # with the test's early return inside an inlined law, a point out of reach cost 240 ns
+        # instead of about 30; with the law a call of 34 arguments, a point in reach cost about
+        # 500 ns more than written out (measured: THF beta 45 at 3 s, 188 of 1,006 points in
+        # reach, 132-156 against 50-60 us a call).
         rod_seg[c] = -1
         q = points[c]
         p0 = gather(xs, pn, pw, q, 0)
@@ -182,13 +120,65 @@ def _contact_forces(xs, vs, ms, fixed_s, pn, pw, ps, held_n, xr, vr, mr, seg, po
         best, best_s, best_t = _nearest_segment(p0, p1, p2, xr, seg, ptr, cand, c)
         if best_s < 0 or best >= reach2 or best <= 0.0:
             continue
-        e, pd, pf, a, fn = _contact_one(c, q, p0, p1, p2, best, best_s, best_t, xs, vs, ms, fixed_s, pn, pw, ps,
-                                        held_n, xr, vr, mr, seg, radius, offset, k_free, k_held, zeta, mu, v_slip, dt,
-                                        rod_seg, rod_t, rod_k, rod_f, damp_f, fric_f)
-        energy += e
-        p_damp += pd
-        p_fric += pf
-        n_active += a
+        reach = radius + offset
+        dist = math.sqrt(best)
+        pen = reach - dist
+        a = seg[best_s, 0]
+        b = seg[best_s, 1]
+        t = best_t
+        held = point_held(fixed_s, pn, pw, q)
+        if held and (held_n[q, 0] != 0.0 or held_n[q, 1] != 0.0 or held_n[q, 2] != 0.0):
+            # a point of the rigid fixed wall: it pushes along that wall's normal at rest
+            n0 = held_n[q, 0]
+            n1 = held_n[q, 1]
+            n2 = held_n[q, 2]
+        else:
+            n0 = (p0 - ((1.0 - t) * xr[a, 0] + t * xr[b, 0])) / dist
+            n1 = (p1 - ((1.0 - t) * xr[a, 1] + t * xr[b, 1])) / dist
+            n2 = (p2 - ((1.0 - t) * xr[a, 2] + t * xr[b, 2])) / dist
+        m = pw[q, 0] * ms[pn[q, 0]]
+        for j in range(1, pn.shape[1]):
+            m += pw[q, j] * ms[pn[q, j]]
+        m *= ps[q]
+        mrc = (1.0 - t) * mr[a] + t * mr[b]
+        meff = mrc if held else m * mrc / (m + mrc)
+        k = (k_held if held else k_free) * ps[q]
+        u0 = gather(vs, pn, pw, q, 0) - ((1.0 - t) * vr[a, 0] + t * vr[b, 0])
+        u1 = gather(vs, pn, pw, q, 1) - ((1.0 - t) * vr[a, 1] + t * vr[b, 1])
+        u2 = gather(vs, pn, pw, q, 2) - ((1.0 - t) * vr[a, 2] + t * vr[b, 2])
+        vn = u0 * n0 + u1 * n1 + u2 * n2
+        elastic = k * pen
+        fn = elastic - 2.0 * zeta * math.sqrt(k * meff) * vn
+        if fn < 0.0:
+            fn = 0.0
+        e_c = 0.5 * k * pen * pen
+        pd_c = -(fn - elastic) * vn
+        damp_f[c, 0] = (fn - elastic) * n0
+        damp_f[c, 1] = (fn - elastic) * n1
+        damp_f[c, 2] = (fn - elastic) * n2
+        t0 = u0 - vn * n0
+        t1 = u1 - vn * n1
+        t2 = u2 - vn * n2
+        vt = math.sqrt(t0 * t0 + t1 * t1 + t2 * t2)
+        ft = 0.0
+        pf_c = 0.0
+        if mu > 0.0 and fn > 0.0:
+            vreg = max(v_slip, mu * fn * dt / meff)
+            ft = mu * fn / max(vt, vreg)
+            pf_c = ft * vt * vt
+        fric_f[c, 0] = -ft * t0
+        fric_f[c, 1] = -ft * t1
+        fric_f[c, 2] = -ft * t2
+        rod_seg[c] = best_s
+        rod_t[c] = t
+        rod_k[c] = k
+        rod_f[c, 0] = -(fn * n0 - ft * t0)
+        rod_f[c, 1] = -(fn * n1 - ft * t1)
+        rod_f[c, 2] = -(fn * n2 - ft * t2)
+        energy += e_c
+        p_damp += pd_c
+        p_fric += pf_c
+        n_active += 1
         normal += fn
     return energy, p_damp, p_fric, n_active, normal
 
