@@ -5,7 +5,7 @@ insertion/engine/shell_bounds.py)."""
 import numpy as np
 import pytest
 
-from colonsim.insertion.engine.constraints import FixedNodes, PrescribedVelocity
+from colonsim.insertion.engine.constraints import FixedNodes, NodalLoad, PrescribedVelocity
 from colonsim.insertion.engine.contact import RodShellContact
 from colonsim.insertion.engine.material import REFERENCE_MATERIAL_PATH, load_material
 from colonsim.insertion.engine.rod import Rod
@@ -27,10 +27,11 @@ def _tube():
     return Shell(nodes, tri, WALL_T, load_material(REFERENCE_MATERIAL_PATH), name="colon")
 
 
-def _run(leave_out=True, contact_reach=None):
+def _run(leave_out=True, contact_reach=None, late_load=False):
     """A scope pushed along the tube and pressed into its wall on both sides of the line where the
     wall's far half is held (the contact reaches held nodes and free ones); returns the solver
-    after ``STEPS`` steps and the held part's constraint reaction at every step."""
+    after ``STEPS`` steps and the held part's constraint reaction at every step. ``late_load``: a
+    force on a held node far from the scope, added half-way."""
     wall = _tube()
     x0 = wall.x0[:, 0].min()
     held = np.flatnonzero(wall.x0[:, 0] > x0 + 0.5 * LENGTH)
@@ -45,7 +46,10 @@ def _run(leave_out=True, contact_reach=None):
     push = PrescribedVelocity(rod, [0], (0.5, 0.2, 0.0))
     sim = ExplicitSolver([rod, wall], contacts=[contact], constraints=[fixed, push], damping={"colon": 50.0})
     reactions = []
-    for _ in range(STEPS):
+    for step in range(STEPS):
+        if late_load and step == STEPS // 2:
+            far = held[np.argmax(wall.x0[held, 0])]
+            sim.loads.append(NodalLoad(wall, [far], (0.0, 0.0, 1.0)))
         sim.advance()
         reactions.append(fixed.reaction.copy())
     return sim, np.array(reactions)
@@ -89,6 +93,15 @@ def _every_element(wall, x, scale):
     rows = np.zeros_like(x)
     gather(buf, wall._hinge_ptr, wall._hinge_slots, rows)
     return float(omega2.max()), max_row_over_mass(rows, wall.mass)
+
+
+def test_a_load_added_later_is_seen():
+    # a load on the wall puts every node back in the update: the held node it pulls has its reaction
+    sim, reactions = _run(late_load=True)
+    _, ref_reactions = _run(leave_out=False, late_load=True)
+    assert len(sim.state["colon"].moving) == len(sim.state["colon"].x)
+    assert np.array_equal(reactions, ref_reactions)
+    assert reactions[-1, 2] == pytest.approx(ref_reactions[STEPS // 2 - 1, 2] - 1.0, abs=0.5)
 
 
 def test_split_bounds_equal_every_element_evaluated():

@@ -246,11 +246,12 @@ class ExplicitSolver:
     def _leave_out_quiet(self, bodies):
         """Tell each body which nodes its explicit update may leave out (:meth:`BodyState.leave_out_quiet`):
         held, at rest, on no element that is not all held, on no contact's candidate and on a body
-        no load or resistance acts on. Asked again whenever the held nodes change or a contact
-        revises the nodes it may reach (its ``revision``); a body or contact that cannot say
+        no load or resistance acts on. Asked again whenever the held nodes change, a constraint,
+        load or resistance is added, or a contact revises the nodes it may reach (its
+        ``revision``); a body or contact that cannot say
         (no ``force_nodes`` / ``nodes_on``) leaves nothing out."""
-        key = (self._fixed_key, tuple(getattr(c, "revision", None) for c in self.contacts))
-        if key == self._quiet_key and None not in key[1]:
+        key = (self._fixed_key, self._per_body[0], tuple(getattr(c, "revision", None) for c in self.contacts))
+        if key == self._quiet_key and None not in key[2]:
             return
         self._quiet_key = key
         for s, _, _, written in bodies:
