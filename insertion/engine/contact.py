@@ -35,7 +35,7 @@ import numpy as np
 
 from colonsim.errors import ColonsimError
 from colonsim.insertion.engine.contact_broad_phase import (candidate_counts, candidate_fill, max_displacement,
-                                                           segment_cell_table)
+                                                           max_displacement_at, segment_cell_table)
 from colonsim.insertion.engine.contact_kernel import (contact_kernel, contact_kernel_serial, contact_spring_action,
                                                       dissipation_rates, rod_reactions, wall_reactions)
 from colonsim.insertion.engine.contact_points import WALL_SAMPLINGS, face_points, node_points
@@ -131,6 +131,7 @@ class RodShellContact:
         self._xr_build = None
         self._xs_build = None
         self.n_rebuilds = 0
+        self._still = (None, -1, 0.0)  # (moving nodes, build, the other nodes' largest displacement)
         # below this many candidate wall nodes the narrow phase runs serially (cheaper than threads)
         self.parallel_min_candidates = 20_000
         self._points = np.zeros(0, dtype=np.int64)
@@ -186,11 +187,23 @@ class RodShellContact:
         """Candidate (contact point, segment) pairs of the current list."""
         return len(self._cand)
 
-    def _needs_rebuild(self, xr, xs):
+    def _needs_rebuild(self, xr, xs, moving=None):
+        """Have the rod and the wall moved farther than the skin since the last build? ``moving``:
+        the wall nodes the solver updates (None: all); the others stand still, so their part of
+        the largest displacement is kept until the list or the build changes (a maximum split in
+        two: the same number)."""
         if self._xr_build is None:
             return True
-        moved = max_displacement(xr, self._xr_build) + max_displacement(xs, self._xs_build)
-        return moved > self.skin
+        if moving is None:
+            wall = max_displacement(xs, self._xs_build)
+        else:
+            if self._still[0] is not moving or self._still[1] != self.n_rebuilds:
+                still = np.ones(len(xs), dtype=bool)
+                still[moving] = False
+                self._still = (moving, self.n_rebuilds,
+                               max_displacement_at(xs, self._xs_build, np.flatnonzero(still)))
+            wall = max(self._still[2], max_displacement_at(xs, self._xs_build, moving))
+        return max_displacement(xr, self._xr_build) + wall > self.skin
 
     def build_candidates(self, xr, xs):
         """Rebuild the candidate pairs for rod positions xr and wall positions xs (the points move no
@@ -221,7 +234,8 @@ class RodShellContact:
         """Add contact forces at the current state into the bodies' ``f_con`` buffers."""
         r = state[self.rod.name]
         s = state[self.shell.name]
-        if self._needs_rebuild(r.x, s.x):
+        moving = getattr(s, "moving", None)
+        if self._needs_rebuild(r.x, s.x, None if moving is None or moving is s.every_node else moving):
             self.build_candidates(r.x, s.x)
         kernel = contact_kernel if len(self._points) >= self.parallel_min_candidates else contact_kernel_serial
         pts = self.points
