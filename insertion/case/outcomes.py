@@ -237,23 +237,6 @@ def principal_stretches(x, triangles, dm_inv):
 
 
 @numba.njit(cache=True)
-def largest_displacement(x, x0, nodes):
-    """The largest distance of ``nodes`` from their reference positions, m (0 for none); the
-    squares summed in the order NumPy sums a row of three, so it equals
-    ``sqrt(((x[nodes] - x0[nodes]) ** 2).sum(axis=1).max())`` to the bit, without its copies."""
-    top = 0.0
-    for j in range(nodes.shape[0]):
-        i = nodes[j]
-        d0 = x[i, 0] - x0[i, 0]
-        d1 = x[i, 1] - x0[i, 1]
-        d2 = x[i, 2] - x0[i, 2]
-        s = d0 * d0 + d1 * d1 + d2 * d2
-        if s > top or s != s:  # NaN wins, as in numpy's max
-            top = s
-    return math.sqrt(top)
-
-
-@numba.njit(cache=True)
 def mark_loaded(force, marks):
     """Set ``marks[i]`` where node i carries a force (any component of ``force`` (n, 3) non-zero)."""
     for i in range(force.shape[0]):

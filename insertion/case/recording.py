@@ -23,9 +23,10 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from colonsim.insertion.case.outcomes import (JAM_PUSH, arc_along, jammed, largest_displacement,
-                                             principal_stretches, sliding_kinetic_energy, tip_heading)
+from colonsim.insertion.case.outcomes import (JAM_PUSH, arc_along, jammed, principal_stretches,
+                                             sliding_kinetic_energy, tip_heading)
 from colonsim.insertion.case.stretch_map import WallStretch, attach
+from colonsim.insertion.engine.contact_broad_phase import max_displacement_at
 
 
 class InsertionRecorder:
@@ -62,7 +63,7 @@ class InsertionRecorder:
         m = self.model
         colon = solver.state["colon"]
         scope = solver.state[m.rod.name]
-        deformation = largest_displacement(colon.x, m.shell.x0, self._mobile)
+        deformation = max_displacement_at(colon.x, m.shell.x0, self._mobile)
         tip = scope.x[self._tip]
         depth = m.push.depth(solver.time)
         tip_arc = float(arc_along(self._arc_points, self._arc, self._arc_tangents, tip))

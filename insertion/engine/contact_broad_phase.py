@@ -89,14 +89,18 @@ def candidate_fill(xs, xr, seg, keys, ids, cutoff, cell, nodes, ptr, out):
 
 @numba.njit(cache=True)
 def max_displacement_at(x, x_ref, nodes):
-    """Largest distance between x and x_ref over ``nodes``, m (0 for none)."""
+    """Largest distance between x and x_ref over ``nodes``, m (0 for none; NaN if any is). The
+    squares are summed in the order NumPy sums a row of three, so it equals
+    ``sqrt(((x[nodes] - x_ref[nodes]) ** 2).sum(axis=1).max())`` to the bit, without its copies."""
     worst = 0.0
     for j in range(nodes.shape[0]):
         i = nodes[j]
         d0 = x[i, 0] - x_ref[i, 0]
         d1 = x[i, 1] - x_ref[i, 1]
         d2 = x[i, 2] - x_ref[i, 2]
-        worst = max(worst, d0 * d0 + d1 * d1 + d2 * d2)
+        s = d0 * d0 + d1 * d1 + d2 * d2
+        if s > worst or s != s:  # NaN wins, as in NumPy's max
+            worst = s
     return math.sqrt(worst)
 
 
