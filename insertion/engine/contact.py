@@ -189,12 +189,12 @@ class RodShellContact:
 
     def _needs_rebuild(self, xr, xs, moving=None):
         """Have the rod and the wall moved farther than the skin since the last build? ``moving``:
-        the wall nodes the solver updates (None: all); the others stand still, so their part of
-        the largest displacement is kept until the list or the build changes (a maximum split in
-        two: the same number)."""
+        the wall nodes the solver updates (None, or every node: all); the others stand still, so
+        their part of the largest displacement is kept until the list or the build changes (a
+        maximum split in two: the same number)."""
         if self._xr_build is None:
             return True
-        if moving is None:
+        if moving is None or len(moving) == len(xs):
             wall = max_displacement(xs, self._xs_build)
         else:
             if self._still[0] is not moving or self._still[1] != self.n_rebuilds:
@@ -234,8 +234,7 @@ class RodShellContact:
         """Add contact forces at the current state into the bodies' ``f_con`` buffers."""
         r = state[self.rod.name]
         s = state[self.shell.name]
-        moving = getattr(s, "moving", None)
-        if self._needs_rebuild(r.x, s.x, None if moving is None or moving is s.every_node else moving):
+        if self._needs_rebuild(r.x, s.x, getattr(s, "moving", None)):
             self.build_candidates(r.x, s.x)
         kernel = contact_kernel if len(self._points) >= self.parallel_min_candidates else contact_kernel_serial
         pts = self.points

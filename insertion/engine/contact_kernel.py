@@ -105,7 +105,8 @@ def _contact_forces(xs, vs, ms, fixed_s, pn, pw, ps, held_n, xr, vr, mr, seg, po
     p_fric = 0.0
     n_active = 0
     normal = 0.0
-    reach2 = (radius + offset) * (radius + offset)
+    reach = radius + offset
+    reach2 = reach * reach
     for c in numba.prange(points.shape[0]):
         # The search and the test for reach first, then the contact law written out in the loop:
         # with the test's early return inside an inlined law, a point out of reach cost 240 ns
@@ -120,7 +121,6 @@ def _contact_forces(xs, vs, ms, fixed_s, pn, pw, ps, held_n, xr, vr, mr, seg, po
         best, best_s, best_t = _nearest_segment(p0, p1, p2, xr, seg, ptr, cand, c)
         if best_s < 0 or best >= reach2 or best <= 0.0:
             continue
-        reach = radius + offset
         dist = math.sqrt(best)
         pen = reach - dist
         a = seg[best_s, 0]
