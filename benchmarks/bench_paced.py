@@ -1,11 +1,11 @@
 """The paced held push against the unpaced one and at half its speed: its rate check from sweep tables.
 
-    python benchmarks/bench_paced.py --paced DIR/paced_rate [--unpaced benchmarks/records/thesis_default_20261207]
+    python benchmarks/bench_paced.py --paced DIR/paced_rate [--unpaced benchmarks/records/thesis]
 
 ``--paced``: the sweep of ``benchmarks/sweeps/paced_rate.toml`` (``held_push_pace`` = 0.9, each
 case at the default push speed and at half of it); ``--unpaced``: a sweep or record of the same
-cases at the default speed without the pace (default: the record ``thesis_default_20261207``, the
-`thesis` preset at the defaults and engine of 2026-12-07). Prints, per case at the default speed,
+cases at the default speed without the pace (default: the record ``thesis``, the
+`thesis` preset at the defaults). Prints, per case at the default speed,
 its steps (simulated time, as the push sets the step count) against the unpaced run's, and the
 rate check's outputs (A, C, final and largest deformation, largest lag, peak contact and push
 forces: the report's ``validation.sections.PAIR_QUANTITIES``) as departures from the unpaced run
@@ -31,7 +31,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # the validation p
 from validation.sections import PAIR_QUANTITIES  # noqa: E402  (the rate check's outputs, floors and bounds)
 from validation.sweeps import relative_change  # noqa: E402
 
-RECORD = Path(__file__).resolve().parent / "records" / "thesis_default_20261207"
+RECORD = Path(__file__).resolve().parent / "records" / "thesis"
 CASE = ("segment", "scope", "angle_deg", "diameter_mm", "friction", "distal_resistance_N")
 
 
@@ -65,7 +65,7 @@ def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--paced", type=Path, required=True, help="the paced_rate sweep folder (results.parquet)")
     parser.add_argument("--unpaced", type=Path, default=RECORD, help="unpaced runs of the same cases at the default "
-                                                                     "speed (default: the record thesis_default_20261207)")
+                                                                     "speed (default: the record thesis)")
     args = parser.parse_args(argv)
     paced, unpaced = _table(args.paced), _table(args.unpaced)
     speed = InsertionCase.push_speed

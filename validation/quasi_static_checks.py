@@ -5,7 +5,7 @@ smoothness checks.
 On the committed sweep records (unpacked into a temporary folder, read only)::
 
     python -m validation.quasi_static_checks --records                 # the report's sweeps
-    python -m validation.quasi_static_checks --records --set global    # the same cases at the global estimate
+    python -m validation.quasi_static_checks --records --set global    # the same cases before the estimate's contact floor
 
 On sweep folders of your own, for a setting the records do not hold::
 
@@ -39,7 +39,8 @@ from .sweeps import TABLE, read_sweep
 from colonsim.catalog import TIP_FOLDED
 from colonsim.insertion.case.insertion_case import InsertionCase
 
-# the records each set reads, by role (the replicates measure the runs' own scatter at the bounds)
+# the records each set reads, by role: the report's sweeps, and the same cases at the global estimate
+# before its contact floor (the replicates, the runs' own scatter, are the report's in both)
 SETS = {"report": {"base": "thesis", "variants": "validation", "smoothness": "smoothness", "gp_train": "gp_train",
                    "gp_test": "gp_test", "replicates": "gp_replicates", "ringing": ("thesis", "validation", "resistance")},
         "global": {"base": "checks_global_base", "variants": "checks_global_variants",
@@ -157,7 +158,7 @@ def main(argv=None):
     parser.add_argument("--records", nargs="?", const=str(RECORDS), default=None,
                         help=f"check the committed sweep records (default folder {RECORDS.relative_to(Path.cwd()) if RECORDS.is_relative_to(Path.cwd()) else RECORDS})")
     parser.add_argument("--set", choices=tuple(SETS), default="report",
-                        help="with --records: the report's sweeps, or the same cases at the global estimate")
+                        help="with --records: the report's sweeps, or the same cases at the global estimate before its contact floor")
     parser.add_argument("--base", help="sweep of base runs (default settings otherwise)")
     parser.add_argument("--variants", help="sweep of their variants: half the push speed, 2 mm wall triangles")
     parser.add_argument("--smoothness", help="sweep of RSJ D36 mu 0 over scope diameters")
