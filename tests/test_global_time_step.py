@@ -105,10 +105,11 @@ def test_the_global_step_is_longer_than_the_bounds_and_stable():
 
 
 def test_the_estimate_enters_a_cases_key_only_when_global():
-    """At "bounds" the key is that of the runs made before the field existed (the thesis record's
-    RSJ 13.3 mm run), so every record stays valid; "global" is another run."""
+    """At "bounds" the key is that of the runs made before the field existed (the RSJ 13.3 mm run
+    of the thesis record made at the bounds, in git history before the records' rerun), so every
+    record of before stays valid; "global" is another run."""
     from colonsim.insertion.case.insertion_case import InsertionCase
 
     bounds = InsertionCase(segment="rsj", scope="13.3", time_step_estimate="bounds")
-    assert bounds.key() == "289196816b34"  # benchmarks/records/thesis
+    assert bounds.key() == "289196816b34"  # the thesis record of before the rerun
     assert InsertionCase(segment="rsj", scope="13.3", time_step_estimate="global").key() != bounds.key()

@@ -1,8 +1,8 @@
 """Sweep records: what the validation report reads of a sweep, small enough to commit.
 
-The report's sweeps take about ten hours of two cores, a machine here gives about two and a half
-hours a sitting, and a sweep folder does not outlive its machine (one RSF run's folder is 3.8 MB,
-most of it the time series' 22 columns). A record keeps of each finished run what the report reads
+The report's sweeps take about an hour and a half of two cores and the predictor's many more, a
+machine here gives about two and a half hours a sitting, and a sweep folder does not outlive its
+machine (one RSF run's folder is 3.8 MB, most of it the time series' 22 columns). A record keeps of each finished run what the report reads
 and nothing else, so a sweep can be run over several sittings and machines, each landing what it
 finished:
 
