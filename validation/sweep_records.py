@@ -2,9 +2,9 @@
 
 The report's sweeps take about an hour and a half of two cores and the predictor's many more, a
 machine here gives about two and a half hours a sitting, and a sweep folder does not outlive its
-machine (one RSF run's folder is 3.8 MB, most of it the time series' 22 columns). A record keeps of each finished run what the report reads
-and nothing else, so a sweep can be run over several sittings and machines, each landing what it
-finished:
+machine (one RSF run's folder is 3.8 MB, most of it the time series' 22 columns). A record keeps
+of each finished run what the report reads and nothing else, so a sweep can be run over several
+sittings and machines, each landing what it finished:
 
 - the sweep's table (``results.parquet``: every row as it is, with its code version) and its
   ``sweep.json`` (the cases it defines);
