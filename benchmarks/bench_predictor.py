@@ -47,8 +47,9 @@ RECORD = RECORDS / "predictor_heldout.json"
 
 
 def records_of(part) -> list:
-    """The committed records of the patient-space sweeps' ``part`` (heldout, replicates) that exist."""
-    return [p for m in MODELS if (p := RECORDS / f"patient_space_{m}_{part}" / "results.parquet").exists()]
+    """The committed records of the patient-space sweeps' ``part`` that exist: "heldout" (each
+    model's held-out hypercubes, ``_heldout`` and ``_heldout2``) or "replicates"."""
+    return [p for m in MODELS for p in sorted(RECORDS.glob(f"patient_space_{m}_{part}*/results.parquet"))]
 
 
 def table_of(paths, what) -> pd.DataFrame:

@@ -22,8 +22,9 @@ def add_parser(sub):
     p.add_argument("spec", nargs="?", type=Path, help="sweep TOML file")
     p.add_argument("--preset", help="thesis (the source's 39 insertions), validation (the validation report's "
                                     "24 extra runs), resistance (the distal resistance study, 136 runs), smoke "
-                                    "(3 fast runs), patient_space (the shipped predictor's 498 runs: its "
-                                    "eleven presets patient_space_MODEL[_more|_more2|_heldout|_replicates], each into its own "
+                                    "(3 fast runs), patient_space (the shipped predictor's 708 runs: its "
+                                    "fourteen presets patient_space_MODEL[_more|_more2|_heldout|_heldout2|_replicates], each "
+                                    "into its own "
                                     "folder under --out)")
     p.add_argument("--workers", type=worker_count, default=None,
                    help=f"local worker processes, one Numba thread each (default: the cores, {available_cores()} here)")

@@ -127,8 +127,10 @@ def test_each_patient_model_has_a_hypercube_and_independent_held_out_and_replica
             for name in inputs:
                 lo, hi = train["lhs"][name]
                 assert lo + (hi - lo) / runs <= other["lhs"][name][0] < other["lhs"][name][1] <= hi - (hi - lo) / runs
-        held = tomllib.loads(patient_space(model, "heldout"))
-        assert held["lhs"]["samples"] >= 30
+        held = [tomllib.loads(patient_space(model, part)) for part in PATIENT_PARTS if part.startswith("heldout")]
+        assert held[0]["lhs"]["samples"] >= 30 and sum(h["lhs"]["samples"] for h in held) == 100
+        seeds = {tomllib.loads(patient_space(model, part))["sweep"]["seed"] for part in ("", *PATIENT_PARTS)}
+        assert len(seeds) == 1 + len(PATIENT_PARTS)  # every part its own hypercube
         assert tomllib.loads(patient_space(model, "replicates"))["grid"][0]["element_size_mm"] == [3, 2.8]
     assert tomllib.loads(patient_space("rsj"))["lhs"]["diameter_mm"] == [20, 40]
 
@@ -141,10 +143,10 @@ def test_the_patient_space_presets_parse_into_cases():
     assert {round(c.stiffness_factor, 3) for c in spec.cases} <= {round(v, 3) for v in np.arange(0.6, 1.6005, 0.001)}
 
 
-def test_one_preset_runs_the_predictors_eleven_sweeps_each_into_its_folder(tmp_path, capsys):
+def test_one_preset_runs_the_predictors_fourteen_sweeps_each_into_its_folder(tmp_path, capsys):
     assert main(["sweep", "--preset", "patient_space", "--dry-run", "--out", str(tmp_path / "ps")]) == 0
     lines = [line for line in capsys.readouterr().out.splitlines() if line.startswith("sweep patient_space")]
-    assert len(lines) == 11 and sum(int(line.split(": ")[1].split()[0]) for line in lines) == 498
+    assert len(lines) == 14 and sum(int(line.split(": ")[1].split()[0]) for line in lines) == 708
     assert f"0 already in {tmp_path / 'ps' / 'patient_space_thf_replicates'}/" in lines[-1]
     assert main(["sweep", "--preset", "patient_space", "--adaptive", "--budget", "5"]) == 2
     assert "--adaptive takes one sweep" in capsys.readouterr().err
