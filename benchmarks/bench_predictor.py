@@ -10,8 +10,8 @@ floor the model was fitted with; else not measured). Tip-folded and failed held-
     python benchmarks/bench_predictor.py --json benchmarks/records/predictor_heldout.json   # the committed table
     python benchmarks/bench_predictor.py --model MODEL.json --heldout /work/runs/patient_space_rsj_heldout ...
 
-Default tables: the committed records ``benchmarks/records/patient_space_{rsj,rsf,thf}_heldout`` and
-``..._replicates`` (``results.parquet``).
+Default tables: the committed records ``benchmarks/records/patient_space_{rsj,rsf,thf}_heldout``, ``..._heldout2``
+(two independent held-out hypercubes, 30 and 70 runs) and ``..._replicates`` (``results.parquet``).
 """
 
 from __future__ import annotations

@@ -6,7 +6,7 @@
 Reads the training sweeps' ``results.parquet`` (default: ``benchmarks/records/patient_space_{rsj,rsf,thf}``
 and THF's further hypercubes ``patient_space_thf_more``, ``_more2``) and their replicate pairs (``..._replicates``, the noise floor),
 fits :func:`colonsim.surrogate.predictor_fit.fit_predictor` (tip-folded runs left out and counted),
-scores it on the held-out sweeps (``..._heldout``, never fitted on) and stores their coverage in the
+scores it on the held-out sweeps (``..._heldout`` and ``..._heldout2``, never fitted on) and stores their coverage in the
 model, where it decides which outputs print intervals
 (:func:`colonsim.surrogate.predictor_fit.vouch`), prints its report and writes
 ``data/predictor/patient_space.json`` + ``.npz`` (or ``--out``).
