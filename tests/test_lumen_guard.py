@@ -1,15 +1,18 @@
 """The check that the scope is still inside the colon (insertion/case/lumen_guard.py).
 
 The depth beyond the wall against the tube's closed form, a scope placed outside flagged and one
-inside not, and a thin scope on a coarse wall mesh that really slips out through the wall: the
-run stops with the fix instead of reporting the displaced wall as colon deformation.
+inside not, the wall closed over its ends enclosing the lumen and nothing else, a scope inside
+that a misleading wall normal puts outside not stopped, and a thin scope on a coarse wall mesh
+that really slips out through the wall: the run stops with the fix instead of reporting the
+displaced wall as colon deformation.
 """
 
 import numpy as np
 import pytest
 
 from colonsim.errors import ColonsimError
-from colonsim.insertion.case.lumen_guard import OUTSIDE_MARGIN, check_scope_inside, depth_outside_wall
+from colonsim.insertion.case.lumen_guard import (OUTSIDE_MARGIN, check_scope_inside, closed_surface,
+                                                 depth_outside_wall, winding_number)
 from colonsim.insertion.case.scenario import InsertionCase, build_insertion, run_insertion
 
 D_MM, T_MM = 36.0, 2.0
@@ -50,6 +53,32 @@ def test_a_scope_outside_the_tube_is_flagged_and_one_inside_is_not(straight):
     with pytest.raises(ColonsimError, match=r"left the colon through its wall 5\.0 cm into the push.*finer --element-size"):
         check_scope_inside(straight, 0.05)
     scope[:] = inside
+
+
+def test_the_wall_closed_over_its_open_ends_encloses_the_lumen_and_nothing_else(straight):
+    x, triangles = straight.shell.x0, straight.shell.triangles
+    points, closed = closed_surface(x, triangles)
+    assert len(points) == len(x) + 2  # one centroid per open end
+    length = x[:, 0].max() - x[:, 0].min()
+    outer = 0.5 * D_MM * 1e-3 + T_MM * 1e-3
+    for p in ([0.5 * length, 0.0, 0.0], [2e-3, 0.0, 0.0], [length - 2e-3, 0.01, 0.0],  # lumen, by either end
+              [0.5 * length, 0.5 * D_MM * 1e-3 - 1e-3, 0.0]):  # near the wall
+        assert winding_number(np.array(p), points, closed) == pytest.approx(1.0, abs=1e-6)
+    for p in ([0.5 * length, outer + 5e-3, 0.0], [-0.01, 0.0, 0.0], [length + 0.01, 0.0, 0.0]):  # outside, beyond the ends
+        assert winding_number(np.array(p), points, closed) == pytest.approx(0.0, abs=1e-6)
+
+
+def test_a_misleading_wall_normal_does_not_stop_a_scope_inside_the_lumen(straight, monkeypatch):
+    # a wall folded hard against itself can give the node nearest a scope node a normal that
+    # points at the scope (a THF loop, 13 mm scope in a 29 mm colon): every node's normal reversed
+    # puts the scope on the axis beyond the wall by the nearest-node test, but the wall encloses it
+    shell = straight.shell
+    normals = shell.node_normals(shell.x0)
+    monkeypatch.setattr(shell, "node_normals", lambda x: -normals)
+    scope = straight.solver.state[straight.rod.name].x
+    tip = scope[-1:]
+    assert depth_outside_wall(tip, shell.x0, -normals, 0.5 * T_MM * 1e-3)[0] > OUTSIDE_MARGIN * straight.rod.radius
+    check_scope_inside(straight, 0.05)  # no error: the winding number says inside
 
 
 @pytest.mark.slow
