@@ -1,10 +1,10 @@
 """The check that the scope is still inside the colon (insertion/case/lumen_guard.py).
 
 The depth beyond the wall against the tube's closed form, a scope placed outside flagged and one
-inside not, the wall closed over its ends enclosing the lumen and nothing else, a scope inside
-that a misleading wall normal puts outside not stopped, and a thin scope on a coarse wall mesh
-that really slips out through the wall: the run stops with the fix instead of reporting the
-displaced wall as colon deformation.
+inside not, a tube's two open ends and a sheet's one, the wall closed over its ends enclosing the
+lumen and nothing else, a scope inside that a misleading wall normal puts outside not stopped, and
+a thin scope on a coarse wall mesh that really slips out through the wall: the run stops with the
+fix instead of reporting the displaced wall as colon deformation.
 """
 
 import numpy as np
@@ -14,6 +14,7 @@ from colonsim.errors import ColonsimError
 from colonsim.insertion.case.lumen_guard import (OUTSIDE_MARGIN, check_scope_inside, closed_surface,
                                                  depth_outside_wall, winding_number)
 from colonsim.insertion.case.scenario import InsertionCase, build_insertion, run_insertion
+from colonsim.insertion.engine.sheet_mesh import boundary_loops, flat_sheet, straight_tube
 
 D_MM, T_MM = 36.0, 2.0
 
@@ -55,9 +56,21 @@ def test_a_scope_outside_the_tube_is_flagged_and_one_inside_is_not(straight):
     scope[:] = inside
 
 
+def test_a_tube_has_two_open_ends_and_a_sheet_one():
+    nodes, triangles, ring = straight_tube(0.1, 0.038, 6e-3)
+    edges, loop = boundary_loops(triangles)
+    assert loop.max() == 1
+    ends = {frozenset(np.flatnonzero(ring == end).tolist()) for end in (0, ring.max())}
+    assert {frozenset(edges[loop == i].ravel().tolist()) for i in (0, 1)} == ends  # each loop an end ring
+    for i in (0, 1):  # a closed chain: every node a tail once and a head once
+        assert np.array_equal(np.sort(edges[loop == i][:, 0]), np.sort(edges[loop == i][:, 1]))
+    _, sheet = flat_sheet(0.1, 0.05, 5e-3)
+    assert boundary_loops(sheet)[1].max() == 0
+
+
 def test_the_wall_closed_over_its_open_ends_encloses_the_lumen_and_nothing_else(straight):
     x, triangles = straight.shell.x0, straight.shell.triangles
-    points, closed = closed_surface(x, triangles)
+    points, closed = closed_surface(x, triangles, boundary_loops(triangles))
     assert len(points) == len(x) + 2  # one centroid per open end
     length = x[:, 0].max() - x[:, 0].min()
     outer = 0.5 * D_MM * 1e-3 + T_MM * 1e-3

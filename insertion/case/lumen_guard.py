@@ -28,8 +28,6 @@ subtend, over 4 pi) is 1 inside and 0 outside, whatever the folds, and is taken 
 from __future__ import annotations
 
 import numpy as np
-from scipy.sparse import coo_matrix
-from scipy.sparse.csgraph import connected_components
 from scipy.spatial import cKDTree
 
 from colonsim.errors import ColonsimError
@@ -51,22 +49,17 @@ def depth_outside_wall(scope_x, wall_x, wall_normals, half_thickness):
     return np.einsum("ij,ij->i", scope_x - wall_x[nearest], wall_normals[nearest]) - half_thickness
 
 
-def closed_surface(x, triangles):
-    """The triangles of the surface ``triangles`` at positions ``x`` closed over each of its open
-    ends: every boundary edge (an edge of one triangle) joined to the centroid of its boundary loop,
-    in the orientation that continues its triangle's. Returns (points, triangles) with the centroids
-    appended to ``x``."""
-    edges = np.concatenate([triangles[:, [0, 1]], triangles[:, [1, 2]], triangles[:, [2, 0]]])
-    _, inverse, counts = np.unique(np.sort(edges, axis=1), axis=0, return_inverse=True, return_counts=True)
-    boundary = edges[counts[inverse.ravel()] == 1]  # in their triangle's direction
+def closed_surface(x, triangles, open_ends):
+    """The surface ``triangles`` at positions ``x`` closed over each of its open ends: every
+    boundary edge joined to the centroid of its boundary loop, in the orientation that continues
+    its triangle's. ``open_ends``: the boundary edges and the loop of each
+    (:func:`colonsim.insertion.engine.sheet_mesh.boundary_loops`). Returns (points, triangles) with
+    the centroids appended to ``x``."""
+    boundary, loop = open_ends
     if not len(boundary):
         return x, triangles
-    n = len(x)
-    graph = coo_matrix((np.ones(len(boundary)), (boundary[:, 0], boundary[:, 1])), shape=(n, n))
-    _, loop_of = connected_components(graph, directed=False)
-    loops, loop_index = np.unique(loop_of[boundary[:, 0]], return_inverse=True)
-    centroids = np.array([x[np.unique(boundary[loop_index == i])].mean(axis=0) for i in range(len(loops))])
-    caps = np.c_[boundary[:, 1], boundary[:, 0], n + loop_index]
+    centroids = np.array([x[np.unique(boundary[loop == i])].mean(axis=0) for i in range(int(loop.max()) + 1)])
+    caps = np.c_[boundary[:, 1], boundary[:, 0], len(x) + loop]
     return np.vstack([x, centroids]), np.vstack([triangles, caps])
 
 
@@ -96,7 +89,7 @@ def check_scope_inside(model, depth_m):
     flagged = np.flatnonzero(outside > OUTSIDE_MARGIN * model.rod.radius)
     if not flagged.size:
         return
-    points, triangles = closed_surface(wall_x, model.shell.triangles)
+    points, triangles = closed_surface(wall_x, model.shell.triangles, model.shell.open_ends())
     beyond = [j for j in flagged if winding_number(scope_x[inserted[j]], points, triangles) < 0.5]
     if beyond:  # the worst of the nodes the wall does not enclose
         k = max(beyond, key=lambda j: outside[j])

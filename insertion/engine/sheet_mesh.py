@@ -1,4 +1,5 @@
-"""Triangle meshes of the colon wall mid-surface: a flat sheet, a straight tube, and their hinges.
+"""Triangle meshes of the colon wall mid-surface: a flat sheet, a straight tube, their hinges and
+their open ends.
 
 Both meshes use rows (rings) of nodes offset by half a step from one row to the next, so the
 triangles are close to equilateral. That matters beyond looks: the discrete hinge bending energy
@@ -7,6 +8,8 @@ converges to a different, direction-dependent stiffness).
 """
 
 import numpy as np
+from scipy.sparse import coo_matrix
+from scipy.sparse.csgraph import connected_components
 
 from colonsim.errors import ColonsimError
 
@@ -151,6 +154,42 @@ def orient_outward(nodes, triangles, centres):
     return triangles
 
 
+def _edge_groups(triangles):
+    """The directed edges of ``triangles`` grouped by the edge they run along: ``(tail, head,
+    opp, order, starts, counts)``, the directed edges (one per triangle side, the opposite node of
+    each), the order that sorts them by undirected edge, and where each edge's group starts in
+    that order and how many directed edges it holds (1 on a boundary, 2 inside a manifold)."""
+    tri = np.ascontiguousarray(triangles, dtype=np.int64)
+    if tri.ndim != 2 or tri.shape[1] != 3:
+        raise ColonsimError(f"triangles must be an (nt, 3) array, got shape {tri.shape}; fix the mesh.")
+    tail = tri[:, [0, 1, 2]].ravel()
+    head = tri[:, [1, 2, 0]].ravel()
+    opp = tri[:, [2, 0, 1]].ravel()
+    n = int(tri.max()) + 1 if len(tri) else 0
+    key = np.minimum(tail, head) * n + np.maximum(tail, head)
+    order = np.argsort(key, kind="stable")
+    key_sorted = key[order]
+    starts = np.flatnonzero(np.r_[True, key_sorted[1:] != key_sorted[:-1]])
+    counts = np.diff(np.r_[starts, len(key_sorted)])
+    return tail, head, opp, order, starts, counts
+
+
+def boundary_loops(triangles):
+    """The open ends of a triangle mesh: its boundary edges (the edges of one triangle) as
+    ``(k, 2)`` node pairs in their triangle's direction, and for each the index of the boundary
+    loop (the connected chain of boundary edges) it lies on, from 0 (a tube: its two ends)."""
+    tail, head, _, order, starts, counts = _edge_groups(triangles)
+    one = order[starts[counts == 1]]
+    edges = np.column_stack((tail[one], head[one]))
+    if not len(edges):
+        return edges, np.zeros(0, dtype=np.int64)
+    n = int(edges.max()) + 1
+    graph = coo_matrix((np.ones(len(edges)), (edges[:, 0], edges[:, 1])), shape=(n, n))
+    _, component = connected_components(graph, directed=False)
+    _, loop = np.unique(component[edges[:, 0]], return_inverse=True)
+    return edges, loop.ravel()
+
+
 def hinges(triangles):
     """Interior edges with their two opposite nodes.
 
@@ -170,22 +209,9 @@ def hinges(triangles):
     ColonsimError
         An edge shared by more than two triangles, or two triangles with opposite orientation.
     """
-    tri = np.ascontiguousarray(triangles, dtype=np.int64)
-    if tri.ndim != 2 or tri.shape[1] != 3:
-        raise ColonsimError(f"triangles must be an (nt, 3) array, got shape {tri.shape}; fix the mesh.")
-    nt = len(tri)
-    # Directed edges (tail, head) and the opposite node of each.
-    tail = tri[:, [0, 1, 2]].ravel()
-    head = tri[:, [1, 2, 0]].ravel()
-    opp = tri[:, [2, 0, 1]].ravel()
-    n = int(tri.max()) + 1 if nt else 0
-    lo = np.minimum(tail, head)
-    hi = np.maximum(tail, head)
-    key = lo * n + hi
-    order = np.argsort(key, kind="stable")
-    key_sorted = key[order]
-    starts = np.flatnonzero(np.r_[True, key_sorted[1:] != key_sorted[:-1]])
-    counts = np.diff(np.r_[starts, len(key_sorted)])
+    tail, head, opp, order, starts, counts = _edge_groups(triangles)
+    n = int(max(tail.max(), head.max())) + 1 if len(tail) else 0
+    key_sorted = (np.minimum(tail, head) * n + np.maximum(tail, head))[order]
     if np.any(counts > 2):
         bad = key_sorted[starts[counts > 2][0]]
         raise ColonsimError(

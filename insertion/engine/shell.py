@@ -23,7 +23,7 @@ import numpy as np
 
 from colonsim.errors import ColonsimError
 from colonsim.insertion.engine._scatter import gather, node_incidence
-from colonsim.insertion.engine.sheet_mesh import hinges as mesh_hinges
+from colonsim.insertion.engine.sheet_mesh import boundary_loops, hinges as mesh_hinges
 from colonsim.insertion.engine.shell_bounds import SplitBounds
 from colonsim.insertion.engine.shell_forces import internal_forces, triangle_reference
 from colonsim.insertion.engine.shell_hinges import bending_stiffness, dihedral_angles, hinge_stiffness
@@ -166,6 +166,7 @@ class Shell:
         check_dispatched(material.law_model, self._law_params)
         self.density = float(density)
         self.hinges = mesh_hinges(triangles)
+        self._open_ends = None  # found when first asked (open_ends)
 
         self.dm_inv, self.area0 = reference_frames(nodes, triangles)
         self._lumped_mass = np.zeros(len(nodes))
@@ -268,6 +269,14 @@ class Shell:
         """Signed volume term whose gradient is the pressure load per Pa (see :func:`enclosed_volume`), m^3."""
         self._check_x(x)
         return enclosed_volume(x, self.triangles)
+
+    def open_ends(self):
+        """The wall's boundary edges and the boundary loop of each
+        (:func:`colonsim.insertion.engine.sheet_mesh.boundary_loops`), found once: the mesh's
+        topology does not change."""
+        if self._open_ends is None:
+            self._open_ends = boundary_loops(self.triangles)
+        return self._open_ends
 
     def node_normals(self, x):
         """Unit outward normals (n, 3), area-weighted over the incident triangles."""
